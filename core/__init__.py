@@ -11,8 +11,10 @@ declared linear, row 0 at the top, straight alpha.
 
 from ._engine import BACKENDS, Engine, RecoveryMaps
 from ._errors import InputError
+from ._io import read_image, write_image
 from ._recover import recover
 
 __version__ = "0.1.0"
 
-__all__ = ["recover", "Engine", "RecoveryMaps", "InputError", "BACKENDS", "__version__"]
+__all__ = ["recover", "Engine", "RecoveryMaps", "InputError", "BACKENDS", "read_image", "write_image",
+           "__version__"]

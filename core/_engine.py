@@ -6,9 +6,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._contract import check_same_size, from_rgba_float, layout_of
+from ._contract import check_same_size, from_rgba_float, layout_of, to_rgba_float
 from ._errors import InputError
-from ._params import Parameters, check_blend_space
+from ._params import Parameters, check_blend_space, check_mode
 
 __all__ = ["Engine", "RecoveryMaps", "BACKENDS"]
 
@@ -86,7 +86,11 @@ class Engine:
     def __init__(self, backend="auto", *, context=None):
         self._impl = _make_backend(backend, context)
         self._layout = None
+        self._pair = None
+        self._plans = {}
         self.last_seconds = None
+        #: SafePlan or None: what the last ``compute(mode="safe")`` decided (blend space, strength, why).
+        self.last_plan = None
 
     @property
     def backend(self):
@@ -103,7 +107,7 @@ class Engine:
         """tuple of int: ``(width, height)`` of the loaded pair, or None."""
         return None if self._layout is None else (self._layout.width, self._layout.height)
 
-    def set_images(self, original, filtered, *, linear=False, blend_space="linear"):
+    def set_images(self, original, filtered, *, linear=False, blend_space=None):
         """Check and load an image pair (uploads it once for GL).
 
         Parameters
@@ -113,9 +117,10 @@ class Engine:
             and dtypes may differ (a colour-to-grey filter gives a grey F for an RGB O).
         linear : bool
             True when both images hold linear-light values; by default they are sRGB-encoded.
-        blend_space : {"linear", "srgb"}
-            Where the blend model is fitted and imposed. ``"linear"`` is the paper's choice and
-            right for optical (camera) antialiasing.
+        blend_space : {"linear", "srgb"}, optional
+            Where the blend model is fitted and imposed. By default ``mode="safe"`` picks it
+            per image and ``mode="paper"`` uses ``"linear"``, the paper's choice and right for
+            optical (camera) antialiasing.
 
         Raises
         ------
@@ -125,15 +130,37 @@ class Engine:
         o_layout = layout_of(original, "original")
         f_layout = layout_of(filtered, "filtered")
         check_same_size(o_layout, f_layout)
-        check_blend_space(blend_space)
-        self._impl.load(original, o_layout, filtered, f_layout, bool(linear), blend_space)
+        if blend_space is not None:
+            check_blend_space(blend_space)
+        loaded = blend_space or "linear"
+        self._impl.load(original, o_layout, filtered, f_layout, bool(linear), loaded)
         self._layout = f_layout
+        self._pair = (original, o_layout, filtered, f_layout, bool(linear), blend_space, loaded)
+        self._plans = {}
+
+    def _load_space(self, space):
+        original, o_layout, filtered, f_layout, linear, requested, loaded = self._pair
+        if space != loaded:
+            self._impl.load(original, o_layout, filtered, f_layout, linear, space)
+            self._pair = (original, o_layout, filtered, f_layout, linear, requested, space)
+
+    def _plan(self, params):
+        """The safe default's decisions for the loaded pair (computed once per parameter set)."""
+        key = (params.sigma_d, params.sigma_e, params.iterations)
+        if key not in self._plans:
+            from ._safeguards import plan_recovery
+            original, o_layout, filtered, f_layout, linear = self._pair[:5]
+            self._plans[key] = plan_recovery(to_rgba_float(original, o_layout, "original"),
+                                             to_rgba_float(filtered, f_layout, "filtered"),
+                                             linear_input=linear, sigma_d=params.sigma_d,
+                                             sigma_e=params.sigma_e, iterations=params.iterations)
+        return self._plans[key]
 
     def _require_images(self):
         if self._layout is None:
             raise InputError("no images loaded: call set_images(original, filtered) first")
 
-    def compute(self, *, sigma_d=0.1, sigma_e=0.01, iterations=3, maps=False):
+    def compute(self, *, sigma_d=0.1, sigma_e=0.01, iterations=3, maps=False, mode="safe"):
         """Run the recovery and keep the result in the backend (on the GPU for GL).
 
         Parameters
@@ -144,9 +171,27 @@ class Engine:
             Jacobi iterations, 0 to 64.
         maps : bool
             Also keep the intermediate maps for :meth:`maps`.
+        mode : {"safe", "paper"}
+            ``"safe"`` first analyses the whole loaded pair once (blend space, blur and
+            point-wise detection, strength calibration; see :attr:`last_plan`) so that
+            recovery does not make F worse; ``"paper"`` is Yang et al. (2011) exactly.
         """
         self._require_images()
+        check_mode(mode)
         params = Parameters(sigma_d, sigma_e, iterations)
+        requested = self._pair[5]
+        if mode == "safe":
+            plan = self._plan(params)
+            self.last_plan = plan
+            self._load_space(requested or plan.blend_space)
+            params = Parameters(sigma_d, sigma_e, iterations, plan.strength)
+        else:
+            self.last_plan = None
+            self._load_space(requested or "linear")
+        self._run(params, maps)
+
+    def _run(self, params, maps):
+        """Run the passes with fully decided parameters (used by ``recover`` on tiles)."""
         start = time.perf_counter()
         self._impl.run(params, maps)
         self._impl.finish()
@@ -163,9 +208,9 @@ class Engine:
         self._require_images()
         return from_rgba_float(self._impl.read_result(), self._layout)
 
-    def recover(self, *, sigma_d=0.1, sigma_e=0.01, iterations=3):
+    def recover(self, *, sigma_d=0.1, sigma_e=0.01, iterations=3, mode="safe"):
         """Compute and return R: :meth:`compute` then :meth:`result`."""
-        self.compute(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations)
+        self.compute(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode)
         return self.result()
 
     def maps(self):
@@ -179,34 +224,31 @@ class Engine:
         return self._impl.read_maps()
 
     def texture(self, name="result"):
-        """GL only: the moderngl texture holding a result, shared with the caller's context.
+        """GL only: a texture of the engine, in its (possibly borrowed) context, for display.
 
         Parameters
         ----------
-        name : {"result", "alpha", "beta", "edge_strength", "residual", "original", "filtered"}
-            ``"result"`` is R as straight RGBA in the input encoding; maps are in the
-            channels documented by :meth:`map_channel`.
+        name : {"result", "original", "filtered", "alpha", "beta", "edge_strength", "residual"}
+            Images are straight RGBA; maps exist after ``compute(maps=True)``.
 
         Returns
         -------
-        moderngl.Texture
+        EngineTexture
+            ``(texture, channel, linear)``: the moderngl texture, the channel holding a map
+            (None for RGBA images), and whether sampled values are linear light (display code
+            must then sRGB-encode them).
         """
         if self.backend != "gl":
             raise InputError("textures exist only on the GL backend; create the engine with backend='gl'")
         self._require_images()
         return self._impl.texture(name)
 
-    def map_channel(self, name):
-        """GL only: ``(texture, channel)`` holding one of the :class:`RecoveryMaps`."""
-        if self.backend != "gl":
-            raise InputError("textures exist only on the GL backend; create the engine with backend='gl'")
-        self._require_images()
-        return self._impl.map_channel(name)
-
     def release(self):
         """Free textures and programs (and the context, if the engine made it)."""
         self._impl.release()
         self._layout = None
+        self._pair = None
+        self._plans = {}
 
     def __enter__(self):
         return self

@@ -23,11 +23,13 @@ class NumpyBackend:
         self._result = self._model = None
 
     def run(self, params, maps):
-        model = fit_blend_model(self._original, self._filtered, params.sigma_d, params.sigma_e)
+        model = fit_blend_model(self._original, self._filtered, params.sigma_d, params.sigma_e,
+                                getattr(params, "strength", 1.0))
         recovered = self._filtered
         for _ in range(params.iterations):
             recovered = jacobi_step(recovered, self._filtered, model)
-        self._result = from_working_space(recovered, self._filtered_rgba, **self._space)
+        self._result = from_working_space(recovered, self._filtered_rgba, filtered_work=self._filtered,
+                                          **self._space)
         self._model = model
 
     def finish(self):

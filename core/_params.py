@@ -5,9 +5,11 @@ from dataclasses import dataclass
 
 from ._errors import InputError
 
-__all__ = ["Parameters", "BLEND_SPACES"]
+__all__ = ["Parameters", "BLEND_SPACES", "MODES", "check_mode"]
 
 BLEND_SPACES = ("linear", "srgb")
+#: ``"safe"``: the default, with per-image safeguards (``_safeguards.py``); ``"paper"``: Yang et al. 2011 exactly.
+MODES = ("safe", "paper")
 MAX_ITERATIONS = 64
 
 
@@ -23,11 +25,15 @@ class Parameters:
         Edge-strength scale, > 0 (paper default 0.01).
     iterations : int
         Jacobi iterations, 0 to 64 (paper default 3; 0 returns F).
+    strength : float
+        Multiplies the confidence ``beta``, in [0, 1]: the safe default's per-image repair
+        strength (1 is the paper's method). Backends pass it to the model fit as a uniform.
     """
 
     sigma_d: float = 0.1
     sigma_e: float = 0.01
     iterations: int = 3
+    strength: float = 1.0
 
     def __post_init__(self):
         for name in ("sigma_d", "sigma_e"):
@@ -40,6 +46,10 @@ class Parameters:
                 or not 0 <= self.iterations <= MAX_ITERATIONS:
             raise InputError(f"iterations must be a whole number from 0 to {MAX_ITERATIONS}, "
                              f"got {self.iterations!r}; 3 is the paper's choice")
+        if isinstance(self.strength, bool) or not isinstance(self.strength, (int, float)) \
+                or not 0 <= self.strength <= 1:
+            raise InputError(f"strength must be a number from 0 to 1, got {self.strength!r}")
+        object.__setattr__(self, "strength", float(self.strength))
         object.__setattr__(self, "sigma_d", float(self.sigma_d))
         object.__setattr__(self, "sigma_e", float(self.sigma_e))
 
@@ -49,3 +59,11 @@ def check_blend_space(blend_space):
     if blend_space not in BLEND_SPACES:
         raise InputError(f"blend_space must be one of {', '.join(BLEND_SPACES)}, got {blend_space!r}")
     return blend_space
+
+
+def check_mode(mode):
+    """Raise unless `mode` is one of :data:`MODES`."""
+    if mode not in MODES:
+        raise InputError(f"mode must be one of {', '.join(MODES)}, got {mode!r}: 'safe' (the default) guards "
+                         "against harming blurred or textured images, 'paper' is the published method exactly")
+    return mode

@@ -2,9 +2,10 @@
 
 import numpy as np
 
-from ._contract import check_same_size, check_values, layout_of
+from ._contract import check_same_size, check_values, layout_of, to_rgba_float
 from ._engine import Engine, RecoveryMaps
-from ._params import Parameters, check_blend_space
+from ._errors import InputError
+from ._params import Parameters, check_blend_space, check_mode
 
 __all__ = ["recover", "halo_for", "tiles"]
 
@@ -52,7 +53,7 @@ def tiles(height, width, tile, halo):
 
 
 def recover(original, filtered, *, sigma_d=0.1, sigma_e=0.01, iterations=3, backend="auto",
-            linear=False, blend_space="linear", return_maps=False, tile_size=None, engine=None):
+            linear=False, blend_space=None, return_maps=False, tile_size=None, engine=None, mode="safe"):
     """Repair the antialiased edges of `filtered` using the edges of `original`.
 
     Parameters
@@ -73,7 +74,8 @@ def recover(original, filtered, *, sigma_d=0.1, sigma_e=0.01, iterations=3, back
     linear : bool, optional
         True when the images hold linear-light values; by default they are sRGB-encoded.
     blend_space : {"linear", "srgb"}, optional
-        Where the two-colour model is fitted and imposed (the paper: linear).
+        Where the two-colour model is fitted and imposed. By default ``mode="safe"`` picks
+        the space in which the image was antialiased, and ``mode="paper"`` uses linear light.
     return_maps : bool, optional
         Also return the :class:`RecoveryMaps`.
     tile_size : int, optional
@@ -81,6 +83,11 @@ def recover(original, filtered, *, sigma_d=0.1, sigma_e=0.01, iterations=3, back
         result equals the untiled one. By default the backend's own limit.
     engine : Engine, optional
         An engine to reuse (its backend wins over `backend`).
+    mode : {"safe", "paper"}, optional
+        ``"safe"`` (the default) analyses the whole pair once before tiling: it picks the
+        blend space, leaves blurred images alone, and calibrates the repair strength so that
+        the result is not worse than `filtered` (see ``docs/quality.md``). ``"paper"`` is the
+        method of Yang et al. (2011) exactly.
 
     Returns
     -------
@@ -106,16 +113,36 @@ def recover(original, filtered, *, sigma_d=0.1, sigma_e=0.01, iterations=3, back
     f_layout = layout_of(filtered, "filtered")
     check_same_size(o_layout, f_layout)
     params = Parameters(sigma_d, sigma_e, iterations)
-    check_blend_space(blend_space)
+    check_mode(mode)
+    if blend_space is not None:
+        check_blend_space(blend_space)
+    if tile_size is not None:
+        smallest = 2 * halo_for(params.iterations) + 1
+        if isinstance(tile_size, bool) or not isinstance(tile_size, (int, np.integer)) or tile_size < smallest:
+            raise InputError(f"tile_size must be a whole number of at least {smallest} pixels with "
+                             f"{params.iterations} iterations (a halo of {halo_for(params.iterations)} "
+                             f"on each side), got {tile_size!r}")
     check_values(original, o_layout, "original")
     check_values(filtered, f_layout, "filtered")
+    if mode == "safe":
+        # Global decisions on the whole image, before tiling, so that tiled == untiled.
+        from ._safeguards import plan_recovery
+        plan = plan_recovery(to_rgba_float(original, o_layout, "original"),
+                             to_rgba_float(filtered, f_layout, "filtered"), linear_input=bool(linear),
+                             sigma_d=params.sigma_d, sigma_e=params.sigma_e, iterations=params.iterations)
+        blend_space = blend_space or plan.blend_space
+        params = Parameters(params.sigma_d, params.sigma_e, params.iterations, plan.strength)
+        if plan.strength == 0 and not return_maps:
+            return filtered.copy()
+    blend_space = blend_space or "linear"
 
     own_engine = engine is None
     if own_engine:
         engine = Engine(backend)
     try:
         limit = engine._impl.max_tile if engine.backend == "gl" else NUMPY_TILE
-        tile = min(limit, tile_size or (GL_TILE if engine.backend == "gl" else NUMPY_TILE))
+        tile = min(limit, tile_size if tile_size is not None else
+                   (GL_TILE if engine.backend == "gl" else NUMPY_TILE))
         height, width = f_layout.height, f_layout.width
         result = np.empty(f_layout.shape, f_layout.dtype)
         maps = None
@@ -123,8 +150,7 @@ def recover(original, filtered, *, sigma_d=0.1, sigma_e=0.01, iterations=3, back
             maps = RecoveryMaps(*(np.empty((height, width), np.float32) for _ in RecoveryMaps.NAMES))
         for inner, outer in tiles(height, width, tile, halo_for(params.iterations)):
             engine.set_images(original[outer], filtered[outer], linear=linear, blend_space=blend_space)
-            engine.compute(sigma_d=params.sigma_d, sigma_e=params.sigma_e, iterations=params.iterations,
-                           maps=return_maps)
+            engine._run(params, return_maps)
             crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
             result[inner] = engine.result()[crop]
             if return_maps:

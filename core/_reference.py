@@ -22,6 +22,9 @@ against supersampled ground truth (see ``docs/quality.md`` and ``shared/notes/pa
   switches recovery off on every real edge (pooled error reduction 0.79 -> 0.02), and the
   other readings cost up to 1 dB. Equation 5 alone is used.
 * If ``c_a`` and ``c_b`` coincide, alpha is undefined and set to 0.5 (beta is 0 there anyway).
+* Where the edge strength is exactly 0 (O or F flat around the pixel), beta is exactly 0
+  and the model is never used; it is not fitted there (alpha 0.5, extremes at the centre,
+  residual 0). The GL pass skips those pixels, which most of a filtered image is.
 * Colour is premultiplied by alpha before the fit, so a transparent pixel is the colour
   (0, 0, 0, 0) and blending towards it lowers coverage without bleeding its hidden colour.
 """
@@ -101,7 +104,7 @@ def to_working_space(rgba, *, linear_input=False, blend_space="linear"):
     return np.concatenate([colour * alpha, alpha], axis=-1).astype(np.float32, copy=False)
 
 
-def from_working_space(work, filtered_rgba, *, linear_input=False, blend_space="linear"):
+def from_working_space(work, filtered_rgba, *, linear_input=False, blend_space="linear", filtered_work=None):
     """Undo :func:`to_working_space`: un-premultiply and re-encode.
 
     Parameters
@@ -113,6 +116,10 @@ def from_working_space(work, filtered_rgba, *, linear_input=False, blend_space="
         where colour cannot be recovered from a premultiplied value.
     linear_input, blend_space
         As given to :func:`to_working_space`.
+    filtered_work : ndarray of float32, shape (H, W, 4), optional
+        F in the working space. Pixels the recovery left exactly at F take `filtered_rgba`
+        as it was: decoding and re-encoding is not exact to the last bit, and a pixel
+        recovery did not touch must come back bit for bit (16-bit and float images).
 
     Returns
     -------
@@ -128,7 +135,11 @@ def from_working_space(work, filtered_rgba, *, linear_input=False, blend_space="
     elif blend_space == "srgb" and linear_input:
         colour = srgb_to_linear(colour)
     colour = np.where(visible, colour, filtered_rgba[..., :3])
-    return np.concatenate([colour, alpha], axis=-1).astype(np.float32, copy=False)
+    result = np.concatenate([colour, alpha], axis=-1).astype(np.float32, copy=False)
+    if filtered_work is not None:
+        untouched = np.all(work == filtered_work, axis=-1)
+        result[untouched] = filtered_rgba[untouched]
+    return result
 
 
 def _shifted(padded, dy, dx, height, width):
@@ -142,8 +153,10 @@ def _sobel_magnitude(image):
     def at(dy, dx):
         return _shifted(padded, dy, dx, height, width)
 
-    gx = (at(-1, 1) + 2 * at(0, 1) + at(1, 1) - at(-1, -1) - 2 * at(0, -1) - at(1, -1)) * np.float32(0.125)
-    gy = (at(1, -1) + 2 * at(1, 0) + at(1, 1) - at(-1, -1) - 2 * at(-1, 0) - at(-1, 1)) * np.float32(0.125)
+    # Differences first: a flat neighbourhood then gives exactly 0 in any summation order,
+    # which the edge test ``e_p == 0`` (and GL/NumPy agreement) relies on.
+    gx = ((at(-1, 1) - at(-1, -1)) + 2 * (at(0, 1) - at(0, -1)) + (at(1, 1) - at(1, -1))) * np.float32(0.125)
+    gy = ((at(1, -1) - at(-1, -1)) + 2 * (at(1, 0) - at(-1, 0)) + (at(1, 1) - at(-1, 1))) * np.float32(0.125)
     return np.sqrt(np.sum(gx * gx + gy * gy, axis=-1))
 
 
@@ -182,7 +195,7 @@ def _principal_direction(deviations):
     return x / np.sqrt(_dot(x, x) + _TINY)[..., None]
 
 
-def fit_blend_model(original, filtered, sigma_d, sigma_e):
+def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0):
     """Fit the two-colour blend model at every pixel of O (section 3.1) and its confidence.
 
     The GL pass of this name also writes the first Jacobi iterate, which it can form from
@@ -197,6 +210,9 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e):
         not candidate extremes, and the residual is weighted by ``G(d_p, sigma_d)``.
     sigma_e : float
         Edge-strength scale of the confidence ``1 - G(e_p, sigma_e)``.
+    strength : float
+        Multiplies the confidence ``beta`` (the safe default's per-image repair strength,
+        see ``_safeguards.py``); 1 is the paper's method and leaves ``beta`` bit-identical.
 
     Returns
     -------
@@ -225,6 +241,14 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e):
     residual = np.sqrt(_dot(miss, miss)).astype(np.float32)
     beta = np.exp(-np.square(residual / np.float32(sigma_d))) * (
         1 - np.exp(-np.square(edge / np.float32(sigma_e))))
+    if strength != 1.0:
+        beta = beta * np.float32(strength)
+    unfitted = edge == 0
+    alpha[unfitted] = 0.5
+    residual[unfitted] = 0
+    index_a[unfitted] = 0
+    index_b[unfitted] = 0
+    beta[unfitted] = 0
     return BlendModel(alpha, beta.astype(np.float32), index_a.astype(np.uint8),
                       index_b.astype(np.uint8), residual, edge)
 
@@ -263,15 +287,15 @@ def jacobi_step(recovered, filtered, model):
     return (beta * (alpha * at_a + (1 - alpha) * at_b) + (1 - beta) * filtered).astype(np.float32)
 
 
-def recover_working(original, filtered, sigma_d, sigma_e, iterations):
-    """Run every pass on working-space images.
+def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1.0):
+    """Run every pass on working-space images (`strength` as in :func:`fit_blend_model`).
 
     Returns
     -------
     recovered : ndarray of float32, shape (H, W, 4)
     model : BlendModel
     """
-    model = fit_blend_model(original, filtered, sigma_d, sigma_e)
+    model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength)
     recovered = filtered
     for _ in range(iterations):
         recovered = jacobi_step(recovered, filtered, model)

@@ -1,0 +1,279 @@
+"""The GL backend behind :class:`aarecovery.Engine`: GLSL 3.30 fragment passes on moderngl.
+
+Passes (each has a NumPy twin of the same name in ``aarecovery._reference``):
+
+0. ``to_working_space``, once per image pair: O and F decoded and premultiplied into float
+   textures, so that parameter changes never decode again.
+1. ``fit_blend_model``: O and F neighbourhoods -> model (alpha, beta, extremes, residual)
+   and the first Jacobi iterate, which needs no pass of its own because the F texels it
+   gathers were already fetched for Sobel.
+2. ``jacobi_step`` (iterations 2..n), the last one fused with ``from_working_space``.
+3. ``from_working_space`` alone only for 0 or 1 iterations.
+
+Colour conversion happens on fetch, in the shader (colour.glsl), for every bit depth.
+sRGB textures would decode 8-bit inputs for free, but llvmpipe's decode is off by up to
+1.2e-3 from the exact curve, and the fit's argmax and 3 sigma_d decisions turn such errors
+into visible differences from the NumPy specification (up to 140/255 on noisy edges,
+measured); the exact shader decode matched NumPy on every test image.
+"""
+
+import contextlib
+import functools
+from collections import namedtuple
+
+import moderngl
+import numpy as np
+
+from .context import REQUIRED_VERSION, GLUnavailable, create_context
+from .shaders import load_source
+
+__all__ = ["GLBackend", "GLUnavailable", "EngineTexture"]
+
+#: A texture the engine shares with its caller: `channel` is None for RGBA images or the
+#: channel holding a map; `linear` says whether sampled values are linear light.
+EngineTexture = namedtuple("EngineTexture", "texture channel linear")
+
+_CONVERT_NONE, _CONVERT_DECODE, _CONVERT_ENCODE = 0, 1, 2
+_UNITS = {"original_image": 0, "filtered_image": 1, "model_map": 2, "previous_iterate": 3, "recovered_work": 3,
+          "original_work": 4, "filtered_work": 5}
+# Where each map lives: (texture key, channel).
+_MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("model", 3),
+                 "edge_strength": ("edge", 0)}
+
+
+def _texture_dtype(dtype):
+    if dtype == np.uint8:
+        return "f1"
+    if dtype == np.uint16:
+        return "nu2"
+    return "f4"
+
+
+def _rgba(image, layout, dtype):
+    """Expand an image to contiguous RGBA in its own bit depth (8/16-bit stay integers)."""
+    height, width = layout.height, layout.width
+    pixels = image.reshape(height, width, layout.channels)
+    rgba = np.empty((height, width, 4), dtype)
+    opaque = {np.dtype(np.uint8): 255, np.dtype(np.uint16): 65535}.get(np.dtype(dtype), 1.0)
+    if layout.grey:
+        rgba[..., :3] = pixels[..., :1]
+    else:
+        rgba[..., :3] = pixels[..., :3]
+    rgba[..., 3] = pixels[..., -1] if layout.alpha else opaque
+    if dtype == np.float32 and layout.dtype.kind == "f":
+        np.clip(rgba, 0, 1, out=rgba)
+    return rgba
+
+
+def _current(method):
+    """Make the engine's own context current around a method.
+
+    Several standalone contexts may live in one process (an engine per thread, a test's
+    second engine); creating or releasing one changes which is current. A borrowed context
+    belongs to its window, whose owner keeps it current.
+    """
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        if not self._owns_context:
+            return method(self, *args, **kwargs)
+        with self.context:
+            return method(self, *args, **kwargs)
+    return wrapper
+
+
+class GLBackend:
+    name = "gl"
+
+    def __init__(self, context=None):
+        if context is None:
+            self.context = create_context()
+            self._owns_context = True
+        else:
+            if context.version_code < REQUIRED_VERSION:
+                raise GLUnavailable(f"the context given offers OpenGL {context.version_code}; "
+                                    f"aarecovery needs {REQUIRED_VERSION} or later")
+            self.context = context
+            self._owns_context = False
+        self.max_tile = int(self.context.info["GL_MAX_TEXTURE_SIZE"])
+        self._programs = {}
+        self._textures = {}
+        self._framebuffers = {}
+        self._key = None
+        self._readback = None
+        self._ran = None
+
+    # -- programs ---------------------------------------------------------------------------
+    def _program(self, fragment, **defines):
+        defines = {**self._defines, **defines}
+        key = (fragment, tuple(sorted(defines.items())))
+        if key not in self._programs:
+            program = self.context.program(vertex_shader=load_source("fullscreen.vert"),
+                                           fragment_shader=load_source(fragment, defines))
+            for uniform, unit in _UNITS.items():
+                if uniform in program:
+                    program[uniform] = unit
+            self._programs[key] = (program, self.context.vertex_array(program, []))
+        return self._programs[key]
+
+    # -- images -----------------------------------------------------------------------------
+    @_current
+    def load(self, original, o_layout, filtered, f_layout, linear_input, blend_space):
+        if blend_space == "linear" and not linear_input:
+            input_mode, output_mode = _CONVERT_DECODE, _CONVERT_ENCODE
+        elif blend_space == "srgb" and linear_input:
+            input_mode, output_mode = _CONVERT_ENCODE, _CONVERT_DECODE
+        else:
+            input_mode = output_mode = _CONVERT_NONE
+        self._defines = {"INPUT_CONVERT": input_mode, "OUTPUT_CONVERT": output_mode}
+        self._linear = dict.fromkeys(("original", "filtered", "result"), linear_input)
+
+        def texture_dtype(layout):
+            return layout.dtype if layout.dtype in (np.uint8, np.uint16) else np.dtype(np.float32)
+
+        o_dtype, f_dtype = texture_dtype(o_layout), texture_dtype(f_layout)
+        size = (f_layout.width, f_layout.height)
+        key = (size, o_dtype, f_dtype)
+        if key != self._key:
+            self._allocate(size, o_dtype, f_dtype)
+            self._key = key
+        t = self._textures
+        t["original"].write(_rgba(original, o_layout, o_dtype))
+        t["filtered"].write(_rgba(filtered, f_layout, f_dtype))
+        with self._passes():
+            self._draw(self._framebuffers["working"], "to_working_space.frag",
+                       {"original_image": t["original"], "filtered_image": t["filtered"]})
+        self._ran = None
+
+    def _texture(self, size, components, dtype):
+        texture = self.context.texture(size, components, dtype=dtype)
+        texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        texture.repeat_x = texture.repeat_y = False
+        return texture
+
+    def _allocate(self, size, o_dtype, f_dtype):
+        self._release_images()
+        t = self._textures
+        t["original"] = self._texture(size, 4, _texture_dtype(o_dtype))
+        t["filtered"] = self._texture(size, 4, _texture_dtype(f_dtype))
+        t["original_work"] = self._texture(size, 4, "f4")
+        t["filtered_work"] = self._texture(size, 4, "f4")
+        t["model"] = self._texture(size, 4, "f4")
+        t["edge"] = self._texture(size, 1, "f4")
+        t["iterate_a"] = self._texture(size, 4, "f4")
+        t["iterate_b"] = self._texture(size, 4, "f4")
+        t["result"] = self._texture(size, 4, _texture_dtype(f_dtype))
+        fb = self._framebuffers
+        fb["working"] = self.context.framebuffer([t["original_work"], t["filtered_work"]])
+        fb["fit"] = self.context.framebuffer([t["model"], t["iterate_a"]])
+        fb["fit_maps"] = self.context.framebuffer([t["model"], t["iterate_a"], t["edge"]])
+        fb["iterate_a"] = self.context.framebuffer([t["iterate_a"]])
+        fb["iterate_b"] = self.context.framebuffer([t["iterate_b"]])
+        fb["result"] = self.context.framebuffer([t["result"]])
+        self._readback = np.empty((size[1], size[0], 4), np.dtype(f_dtype))
+
+    # -- passes -----------------------------------------------------------------------------
+    @contextlib.contextmanager
+    def _passes(self):
+        """Blending and depth tests off for the passes; a borrowed context's framebuffer and
+        enable flags as they were afterwards."""
+        previous = None if self._owns_context else self.context.fbo
+        try:
+            with self.context.scope(self._framebuffers["working"], enable_only=moderngl.NOTHING):
+                yield
+        finally:
+            if previous is not None:
+                previous.use()
+
+    def _draw(self, framebuffer, fragment, inputs, uniforms=None, **defines):
+        program, vertex_array = self._program(fragment, **defines)
+        for name, value in (uniforms or {}).items():
+            if name in program:
+                program[name] = value
+        for uniform, texture in inputs.items():
+            texture.use(_UNITS[uniform])
+        framebuffer.use()
+        vertex_array.render(moderngl.TRIANGLES, vertices=3)
+
+    @_current
+    def run(self, params, maps):
+        t, fb = self._textures, self._framebuffers
+        sources = {"original_work": t["original_work"], "filtered_work": t["filtered_work"],
+                   "filtered_image": t["filtered"]}
+        n = params.iterations
+        with self._passes():
+            if n > 0 or maps:
+                self._draw(fb["fit_maps" if maps else "fit"], "fit_blend_model.frag", sources,
+                           {"sigma_d": params.sigma_d, "sigma_e": params.sigma_e, "strength": params.strength},
+                           MAPS=int(maps))
+            if n == 0:
+                self._draw(fb["result"], "from_working_space.frag", sources, FROM_FILTERED=1)
+            elif n == 1:
+                self._draw(fb["result"], "from_working_space.frag",
+                           {**sources, "recovered_work": t["iterate_a"]}, FROM_FILTERED=0)
+            else:
+                previous = "iterate_a"
+                for step in range(2, n + 1):
+                    final = step == n
+                    target = "result" if final else ("iterate_b" if previous == "iterate_a" else "iterate_a")
+                    self._draw(fb[target], "jacobi_step.frag",
+                               {**sources, "model_map": t["model"], "previous_iterate": t[previous]},
+                               FINAL=int(final))
+                    previous = target
+        self._ran = {"maps": maps}
+
+    @_current
+    def finish(self):
+        self.context.finish()
+
+    # -- results ----------------------------------------------------------------------------
+    @_current
+    def read_result(self):
+        self._textures["result"].read_into(self._readback)
+        return self._readback
+
+    @_current
+    def read_maps(self):
+        from .._engine import RecoveryMaps
+        if not (self._ran and self._ran["maps"]):
+            raise RuntimeError("no maps were computed: call compute(..., maps=True) first")
+        width, height = self._key[0]
+        model = np.empty((height, width, 4), np.float32)
+        self._textures["model"].read_into(model)
+        edge = np.empty((height, width), np.float32)
+        self._textures["edge"].read_into(edge)
+        return RecoveryMaps(np.ascontiguousarray(model[..., 0]), np.ascontiguousarray(model[..., 1]), edge,
+                            np.ascontiguousarray(model[..., 3]))
+
+    def texture(self, name):
+        if name in ("result", "original", "filtered"):
+            return EngineTexture(self._textures[name], None, self._linear[name])
+        if name in _MAP_CHANNELS:
+            if not (self._ran and self._ran["maps"]):
+                raise RuntimeError(f"the {name} map was not computed: call compute(..., maps=True) first")
+            key, channel = _MAP_CHANNELS[name]
+            return EngineTexture(self._textures[key], channel, False)
+        raise KeyError(f"no texture {name!r}; choose from result, original, filtered, "
+                       + ", ".join(_MAP_CHANNELS))
+
+    # -- cleanup ----------------------------------------------------------------------------
+    def _release_images(self):
+        for framebuffer in self._framebuffers.values():
+            framebuffer.release()
+        for texture in self._textures.values():
+            texture.release()
+        self._framebuffers, self._textures = {}, {}
+        self._key = None
+
+    def release(self):
+        self._release_objects()
+        if self._owns_context:
+            self.context.release()
+            self._owns_context = False
+
+    @_current
+    def _release_objects(self):
+        self._release_images()
+        for program, vertex_array in self._programs.values():
+            vertex_array.release()
+            program.release()
+        self._programs = {}

@@ -1,0 +1,107 @@
+#version 330 core
+// Section 3.1 and equation 5: the two-colour blend model of O at each pixel, its confidence,
+// and the first Jacobi iterate (R0 = F), formed from the F texels fetched for Sobel.
+// Twin: fit_blend_model and jacobi_step(F, F, model) in aarecovery/_reference.py.
+#include "working.glsl"
+
+uniform float sigma_d;
+uniform float sigma_e;
+uniform float strength;  // the safe default's per-image repair strength; 1 for the paper
+
+layout(location = 0) out vec4 model;          // alpha, beta, 9 * index_a + index_b, residual
+layout(location = 1) out vec4 first_iterate;  // working space
+#if MAPS
+layout(location = 2) out vec4 edge_map;       // edge strength in .r
+#endif
+
+const float TINY = 1e-12;
+
+float sobel_magnitude(vec4 v[9]) {
+    // v is in OFFSETS order: 1 N, 2 W, 3 E, 4 S, 5 NW, 6 NE, 7 SW, 8 SE.
+    // Differences first, so that a flat neighbourhood gives exactly 0 (see the NumPy twin).
+    vec4 gx = ((v[6] - v[5]) + 2.0 * (v[3] - v[2]) + (v[8] - v[7])) * 0.125;
+    vec4 gy = ((v[7] - v[5]) + 2.0 * (v[4] - v[1]) + (v[8] - v[6])) * 0.125;
+    return sqrt(dot(gx, gx) + dot(gy, gy));
+}
+
+void main() {
+    ivec2 size = textureSize(filtered_work, 0);
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    // F first: where F is flat the edge strength is exactly 0, so beta is 0 and the model
+    // is never used; skipping the fit there is what makes thresholded and posterized
+    // images (mostly flat) fast.
+    vec4 f[9];
+    for (int i = 0; i < 9; ++i) f[i] = texelFetch(filtered_work, clamp_to_image(p + OFFSETS[i], size), 0);
+    float filtered_gradient = sobel_magnitude(f);
+    vec4 c[9];
+    float edge = 0.0;
+    if (filtered_gradient > 0.0) {
+        for (int i = 0; i < 9; ++i) c[i] = texelFetch(original_work, clamp_to_image(p + OFFSETS[i], size), 0);
+        edge = sobel_magnitude(c) * filtered_gradient;
+    }
+#if MAPS
+    edge_map = vec4(edge, 0.0, 0.0, 1.0);
+#endif
+    if (edge == 0.0) {
+        model = vec4(0.5, 0.0, 0.0, 0.0);
+        first_iterate = f[0];
+        return;
+    }
+
+    // Roweis EM for the first principal component, started at the farthest neighbour.
+    vec4 mean = vec4(0.0);
+    for (int i = 0; i < 9; ++i) mean += c[i];
+    mean /= 9.0;
+    vec4 y[9];
+    int start = 0;
+    float farthest = -1.0;
+    for (int i = 0; i < 9; ++i) {
+        y[i] = c[i] - mean;
+        float spread = dot(y[i], y[i]);
+        if (spread > farthest) { farthest = spread; start = i; }
+    }
+    vec4 x = y[start];
+    for (int iteration = 0; iteration < 3; ++iteration) {
+        float xx = dot(x, x) + TINY;
+        vec4 next = vec4(0.0);
+        float zz = 0.0;
+        for (int i = 0; i < 9; ++i) {
+            float z = dot(y[i], x) / xx;
+            next += y[i] * z;
+            zz += z * z;
+        }
+        x = next / (zz + TINY);
+    }
+    x /= sqrt(dot(x, x) + TINY);
+
+    // Extremes along the line through the centre, among neighbours within 3 sigma_d of it;
+    // the first of equal candidates wins (centre, then 4-neighbours, then diagonals).
+    // Extremes are carried as values, not indices: dynamic array indexing makes llvmpipe
+    // spill the arrays to memory.
+    int a = 0;
+    int b = 0;
+    float t_max = 0.0;
+    float t_min = 0.0;
+    vec4 c_a = c[0], c_b = c[0], f_a = f[0], f_b = f[0];
+    for (int i = 1; i < 9; ++i) {
+        vec4 offset = c[i] - c[0];
+        float t = dot(offset, x);
+        vec4 off_line = offset - t * x;
+        if (sqrt(dot(off_line, off_line)) < 3.0 * sigma_d) {
+            if (t > t_max) { t_max = t; a = i; c_a = c[i]; f_a = f[i]; }
+            if (t < t_min) { t_min = t; b = i; c_b = c[i]; f_b = f[i]; }
+        }
+    }
+    vec4 span = c_a - c_b;
+    float span_sq = dot(span, span);
+    float alpha = span_sq > TINY ? clamp(dot(c[0] - c_b, span) / span_sq, 0.0, 1.0) : 0.5;
+    vec4 miss = alpha * c_a + (1.0 - alpha) * c_b - c[0];
+    float residual = sqrt(dot(miss, miss));
+    float edge_ratio = edge / sigma_e;
+    float residual_ratio = residual / sigma_d;
+    float beta = exp(-residual_ratio * residual_ratio) * (1.0 - exp(-edge_ratio * edge_ratio));
+    if (strength != 1.0) beta *= strength;
+
+    model = vec4(alpha, beta, float(9 * a + b), residual);
+    first_iterate = beta * (alpha * f_a + (1.0 - alpha) * f_b) + (1.0 - beta) * f[0];
+}

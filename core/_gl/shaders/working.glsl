@@ -1,0 +1,29 @@
+// The working space (premultiplied RGBA, colour in the blend space) and the way back.
+// Twin of to_working_space / from_working_space in aarecovery/_reference.py.
+// The backend defines OUTPUT_CONVERT (blend space -> input encoding) as a CONVERT_* mode.
+#include "colour.glsl"
+
+uniform sampler2D original_work;
+uniform sampler2D filtered_work;
+uniform sampler2D filtered_image;  // F as given, for the colour of fully transparent pixels
+
+// Neighbourhood order of NEIGHBOUR_OFFSETS (x = column, y = row): centre, N, W, E, S, NW, NE, SW, SE.
+const ivec2 OFFSETS[9] = ivec2[9](
+    ivec2(0, 0), ivec2(0, -1), ivec2(-1, 0), ivec2(1, 0), ivec2(0, 1),
+    ivec2(-1, -1), ivec2(1, -1), ivec2(-1, 1), ivec2(1, 1));
+
+ivec2 clamp_to_image(ivec2 p, ivec2 size) {
+    return clamp(p, ivec2(0), size - 1);
+}
+
+// Straight RGBA in the input encoding; a fully transparent result keeps F's colour, and a
+// pixel the recovery left exactly at F keeps F bit for bit (decode + encode is not exact).
+vec4 from_working(vec4 work, ivec2 p) {
+    if (work == texelFetch(filtered_work, p, 0)) return texelFetch(filtered_image, p, 0);
+    float coverage = clamp(work.a, 0.0, 1.0);
+    if (coverage > 0.0) {
+        vec3 colour = clamp(work.rgb / coverage, 0.0, 1.0);
+        return vec4(convert_colour(colour, OUTPUT_CONVERT), coverage);
+    }
+    return vec4(texelFetch(filtered_image, p, 0).rgb, 0.0);
+}

@@ -1,0 +1,57 @@
+"""Test options shared by the whole suite.
+
+``--backend numpy|gl|all`` picks which backends the backend-parametrised tests run on
+(kornia-style: every such test body runs once per backend). GL tests never skip quietly:
+when no OpenGL context can be made they fail in CI (CI=true) and skip loudly elsewhere.
+"""
+
+import os
+
+import pytest
+
+BACKEND_NAMES = ("numpy", "gl")
+
+
+def pytest_addoption(parser):
+    parser.addoption("--backend", default="all", choices=("all",) + BACKEND_NAMES,
+                     help="run backend-parametrised tests on this backend only (default: all)")
+
+
+def pytest_generate_tests(metafunc):
+    if "backend" in metafunc.fixturenames:
+        chosen = metafunc.config.getoption("--backend")
+        names = BACKEND_NAMES if chosen == "all" else (chosen,)
+        metafunc.parametrize("backend", names)
+
+
+_gl_problem = None
+
+
+def gl_unavailable_reason():
+    """None when a standalone GL 3.3 context can be made here, else why not."""
+    global _gl_problem
+    if _gl_problem is None:
+        from aarecovery._gl.context import GLUnavailable, create_context
+        try:
+            create_context().release()
+            _gl_problem = ""
+        except GLUnavailable as error:
+            _gl_problem = str(error)
+    return _gl_problem or None
+
+
+def require_gl():
+    reason = gl_unavailable_reason()
+    if reason:
+        message = (f"no OpenGL 3.3 context ({reason}); install Mesa's EGL and llvmpipe: "
+                   "apt-get install libegl1 libgl1-mesa-dri (packaging/test.sh does)")
+        if os.environ.get("CI"):
+            pytest.fail(message)
+        pytest.skip("GL TESTS NOT RUN: " + message)
+
+
+@pytest.fixture(autouse=True)
+def _gl_needed(request):
+    if request.node.get_closest_marker("gl") or getattr(request.node, "callspec", None) \
+            and request.node.callspec.params.get("backend") == "gl":
+        require_gl()

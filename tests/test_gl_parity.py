@@ -1,0 +1,141 @@
+"""The GL backend against its NumPy twin, pass by pass.
+
+Stated tolerances: the working-space textures within 1e-6 relative (float32 rounding of the same
+sRGB formula); edge strength within 1e-5 relative; beta and residual within 1e-5; the
+extreme colours chosen by the fit identical on more than 99.9% of pixels (a near-tie in the
+principal direction may flip the sign of the line, which swaps a and b and alpha for 1 - alpha
+without changing the blend); the final R within 1/255 on 8-bit data, 2/65535 on 16-bit and
+1e-5 on float.
+"""
+
+import numpy as np
+import pytest
+
+import aarecovery
+from aarecovery import _reference
+from aarecovery._contract import layout_of, to_rgba_float
+from scenes import luminance, shapes, to_uint8
+
+pytestmark = pytest.mark.gl
+
+
+def pairs():
+    rng = np.random.default_rng(7)
+    noise = (rng.random((40, 56, 3)) * 255).astype(np.uint8)
+    structured = shapes(72, seed=2, noise=0.01)
+    grey = luminance(structured / np.float32(255))
+    yield "random-threshold", noise, np.where(noise > 128, 255, 0).astype(np.uint8)
+    yield "shapes-threshold", structured, np.where(structured > 110, 255, 0).astype(np.uint8)
+    yield "shapes-gradient-map", structured, to_uint8(np.stack([grey ** 0.5, grey, 1 - grey], -1))
+    alpha = structured.copy()
+    alpha = np.concatenate([structured, (grey[..., None] * 255).astype(np.uint8)], -1)
+    yield "rgba-posterize", alpha, (alpha // 64 * 85).astype(np.uint8)
+    sixteen = (structured.astype(np.uint16) * 257 + rng.integers(0, 256, structured.shape)).astype(np.uint16)
+    yield "uint16-threshold", sixteen, np.where(sixteen > 30000, 65535, 0).astype(np.uint16)
+    floats = structured[..., 0] / np.float32(255)
+    yield "float-grey-gamma", floats, floats ** 2.2
+
+
+PAIRS = list(pairs())
+IDS = [name for name, *_ in PAIRS]
+
+
+def _numpy_model(original, filtered, blend_space="linear", linear=False):
+    o = _reference.to_working_space(to_rgba_float(original, layout_of(original, "o"), "o"),
+                                    linear_input=linear, blend_space=blend_space)
+    f = _reference.to_working_space(to_rgba_float(filtered, layout_of(filtered, "f"), "f"),
+                                    linear_input=linear, blend_space=blend_space)
+    return o, f, _reference.fit_blend_model(o, f, 0.1, 0.01)
+
+
+@pytest.fixture(scope="module")
+def gl_engine():
+    engine = aarecovery.Engine(backend="gl")
+    yield engine
+    engine.release()
+
+
+@pytest.mark.parametrize("name, original, filtered", PAIRS, ids=IDS)
+def test_to_working_space(gl_engine, name, original, filtered):
+    gl_engine.set_images(original, filtered, blend_space="linear")
+    expected_o, expected_f, _ = _numpy_model(original, filtered)
+    for key, expected in (("original_work", expected_o), ("filtered_work", expected_f)):
+        with gl_engine.context:
+            raw = gl_engine._impl._textures[key].read()
+        actual = np.frombuffer(raw, np.float32).reshape(expected.shape)
+        np.testing.assert_allclose(actual, expected, rtol=1e-6, atol=1e-7)
+
+
+@pytest.mark.parametrize("name, original, filtered", PAIRS, ids=IDS)
+def test_fit_blend_model(gl_engine, name, original, filtered):
+    gl_engine.set_images(original, filtered, blend_space="linear")
+    gl_engine.compute(mode="paper", maps=True)
+    actual = gl_engine.maps()
+    _, _, expected = _numpy_model(original, filtered)
+    np.testing.assert_allclose(actual.edge_strength, expected.edge, rtol=1e-5, atol=1e-7)
+    np.testing.assert_allclose(actual.beta, expected.beta, rtol=0, atol=1e-5)
+    np.testing.assert_allclose(actual.residual, expected.residual, rtol=0, atol=1e-5)
+    same_or_swapped = (np.abs(actual.alpha - expected.alpha) < 1e-5) | \
+        (np.abs(actual.alpha - (1 - expected.alpha)) < 1e-5)
+    assert same_or_swapped.mean() > 0.999
+
+
+@pytest.mark.parametrize("iterations", [0, 1, 2, 3, 5])
+@pytest.mark.parametrize("name, original, filtered", PAIRS, ids=IDS)
+def test_jacobi_steps_and_result(gl_engine, name, original, filtered, iterations):
+    gl_engine.set_images(original, filtered, blend_space="linear")
+    actual = gl_engine.recover(iterations=iterations, mode="paper")
+    expected = aarecovery.recover(original, filtered, iterations=iterations, backend="numpy", mode="paper",
+                                  blend_space="linear")
+    assert actual.dtype == expected.dtype and actual.shape == expected.shape
+    tolerance = {np.dtype(np.uint8): 1, np.dtype(np.uint16): 2}.get(actual.dtype, 1e-5)
+    assert np.abs(actual.astype(np.float64) - expected).max() <= tolerance
+
+
+@pytest.mark.parametrize("blend_space, linear", [("srgb", False), ("linear", True), ("srgb", True)])
+def test_blend_spaces_and_linear_input(gl_engine, blend_space, linear):
+    _, original, filtered = PAIRS[2]
+    if linear:
+        original, filtered = original / np.float32(255), filtered / np.float32(255)
+    gl_engine.set_images(original, filtered, blend_space=blend_space, linear=linear)
+    actual = gl_engine.recover(mode="paper")
+    expected = aarecovery.recover(original, filtered, backend="numpy", mode="paper",
+                                  blend_space=blend_space, linear=linear)
+    assert np.abs(actual.astype(np.float64) - expected).max() <= (1 if actual.dtype == np.uint8 else 1e-5)
+
+
+def test_safe_mode_agrees(gl_engine):
+    for _, original, filtered in PAIRS:
+        actual = aarecovery.recover(original, filtered, engine=gl_engine)
+        expected = aarecovery.recover(original, filtered, backend="numpy")
+        tolerance = {np.dtype(np.uint8): 1, np.dtype(np.uint16): 2}.get(actual.dtype, 1e-5)
+        assert np.abs(actual.astype(np.float64) - expected).max() <= tolerance
+
+
+def test_engine_reuse_matches_fresh_runs(gl_engine):
+    _, original, filtered = PAIRS[1]
+    gl_engine.set_images(original, filtered)
+    for sigma_d, sigma_e, iterations in [(0.1, 0.01, 3), (0.05, 0.02, 2), (0.2, 0.005, 4)]:
+        again = gl_engine.recover(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode="paper")
+        fresh = aarecovery.recover(original, filtered, sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations,
+                                   backend="gl", mode="paper")
+        np.testing.assert_array_equal(again, fresh)
+
+
+def test_borrowed_context_state_is_restored():
+    import moderngl
+    context = moderngl.create_standalone_context(backend="egl")
+    try:
+        screen = context.simple_framebuffer((8, 8))
+        screen.use()
+        context.enable(moderngl.BLEND)
+        engine = aarecovery.Engine(backend="gl", context=context)
+        _, original, filtered = PAIRS[0]
+        engine.set_images(original, filtered)
+        blended = engine.recover(mode="paper")
+        assert context.fbo == screen
+        engine.release()
+        np.testing.assert_array_equal(blended, aarecovery.recover(original, filtered, backend="numpy", mode="paper"))
+        assert not context.error or context.error == "GL_NO_ERROR"
+    finally:
+        context.release()
