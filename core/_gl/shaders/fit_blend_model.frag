@@ -15,6 +15,7 @@ layout(location = 2) out vec4 edge_map;       // edge strength in .r
 #endif
 
 const float TINY = 1e-12;
+const float FAINT = 1e-30;
 
 float sobel_magnitude(vec4 v[9]) {
     // v is in OFFSETS order: 1 N, 2 W, 3 E, 4 S, 5 NW, 6 NE, 7 SW, 8 SE.
@@ -48,36 +49,37 @@ void main() {
         return;
     }
 
-    // Roweis EM for the first principal component, started at the farthest neighbour.
+    // Roweis EM for one component is power iteration on the 4x4 scatter matrix (see the
+    // NumPy twin), started at the neighbour farthest from the mean.
     vec4 mean = vec4(0.0);
     for (int i = 0; i < 9; ++i) mean += c[i];
     mean /= 9.0;
-    vec4 y[9];
-    int start = 0;
+    vec4 x = vec4(0.0);
     float farthest = -1.0;
+    float s00 = 0.0, s01 = 0.0, s02 = 0.0, s03 = 0.0, s11 = 0.0, s12 = 0.0, s13 = 0.0;
+    float s22 = 0.0, s23 = 0.0, s33 = 0.0;
     for (int i = 0; i < 9; ++i) {
-        y[i] = c[i] - mean;
-        float spread = dot(y[i], y[i]);
-        if (spread > farthest) { farthest = spread; start = i; }
+        vec4 y = c[i] - mean;
+        float spread = dot(y, y);
+        if (spread > farthest) { farthest = spread; x = y; }
+        s00 += y.x * y.x; s01 += y.x * y.y; s02 += y.x * y.z; s03 += y.x * y.w;
+        s11 += y.y * y.y; s12 += y.y * y.z; s13 += y.y * y.w;
+        s22 += y.z * y.z; s23 += y.z * y.w; s33 += y.w * y.w;
     }
-    vec4 x = y[start];
     for (int iteration = 0; iteration < 3; ++iteration) {
-        float xx = dot(x, x) + TINY;
-        vec4 next = vec4(0.0);
-        float zz = 0.0;
-        for (int i = 0; i < 9; ++i) {
-            float z = dot(y[i], x) / xx;
-            next += y[i] * z;
-            zz += z * z;
-        }
-        x = next / (zz + TINY);
+        x = vec4(s00 * x.x + s01 * x.y + s02 * x.z + s03 * x.w,
+                 s01 * x.x + s11 * x.y + s12 * x.z + s13 * x.w,
+                 s02 * x.x + s12 * x.y + s22 * x.z + s23 * x.w,
+                 s03 * x.x + s13 * x.y + s23 * x.z + s33 * x.w);
+        x = x / sqrt(dot(x, x) + FAINT);
     }
-    x /= sqrt(dot(x, x) + TINY);
 
     // Extremes along the line through the centre, among neighbours within 3 sigma_d of it;
     // the first of equal candidates wins (centre, then 4-neighbours, then diagonals).
     // Extremes are carried as values, not indices: dynamic array indexing makes llvmpipe
     // spill the arrays to memory.
+    float reach = 3.0 * sigma_d;
+    float reach_sq = reach * reach;
     int a = 0;
     int b = 0;
     float t_max = 0.0;
@@ -86,8 +88,7 @@ void main() {
     for (int i = 1; i < 9; ++i) {
         vec4 offset = c[i] - c[0];
         float t = dot(offset, x);
-        vec4 off_line = offset - t * x;
-        if (sqrt(dot(off_line, off_line)) < 3.0 * sigma_d) {
+        if (dot(offset, offset) - t * t < reach_sq) {
             if (t > t_max) { t_max = t; a = i; c_a = c[i]; f_a = f[i]; }
             if (t < t_min) { t_min = t; b = i; c_b = c[i]; f_b = f[i]; }
         }

@@ -11,6 +11,7 @@ layout(location = 0) out vec4 original_work;
 layout(location = 1) out vec4 filtered_work;
 
 vec4 to_working(vec4 straight) {
+    straight = clamp(straight, 0.0, 1.0);  // float inputs may stray a hair outside [0, 1]
     return vec4(convert_colour(straight.rgb, INPUT_CONVERT) * straight.a, straight.a);
 }
 

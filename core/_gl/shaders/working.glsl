@@ -19,11 +19,14 @@ ivec2 clamp_to_image(ivec2 p, ivec2 size) {
 // Straight RGBA in the input encoding; a fully transparent result keeps F's colour, and a
 // pixel the recovery left exactly at F keeps F bit for bit (decode + encode is not exact).
 vec4 from_working(vec4 work, ivec2 p) {
-    if (work == texelFetch(filtered_work, p, 0)) return texelFetch(filtered_image, p, 0);
+#if EXACT_UNTOUCHED
+    // 8-bit results round the tiny decode/encode error away, so only deeper ones need this.
+    if (work == texelFetch(filtered_work, p, 0)) return clamp(texelFetch(filtered_image, p, 0), 0.0, 1.0);
+#endif
     float coverage = clamp(work.a, 0.0, 1.0);
     if (coverage > 0.0) {
         vec3 colour = clamp(work.rgb / coverage, 0.0, 1.0);
         return vec4(convert_colour(colour, OUTPUT_CONVERT), coverage);
     }
-    return vec4(texelFetch(filtered_image, p, 0).rgb, 0.0);
+    return vec4(clamp(texelFetch(filtered_image, p, 0).rgb, 0.0, 1.0), 0.0);
 }
