@@ -17,6 +17,12 @@ __all__ = ["main"]
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMANDS = (
     "aarecovery._cli_recover",
+    "aarecovery._bench",
+    "aarecovery._cli_filters",
+    "aarecovery._eval",
+    "aarecovery._demo",
+    "aarecovery.gimp.cli",
+    "aarecovery.viewer.cli",
 )
 
 _EPILOG = """\

@@ -1,0 +1,78 @@
+"""The safe default: its per-image decisions, paper mode unchanged, tiling unchanged."""
+
+import numpy as np
+import pytest
+
+import aarecovery
+from aarecovery import _scenes, filters
+from aarecovery._groundtruth import make_case
+from aarecovery._reference import fit_blend_model, to_working_space
+from aarecovery._safeguards import choose_blend_space, fit_lowpass, fit_pointwise, plan_recovery
+
+
+def rgba(image):
+    return np.concatenate([image, np.ones(image.shape[:2] + (1,), np.float32)], -1)
+
+
+@pytest.fixture(scope="module")
+def shapes():
+    return _scenes.render("shapes", 48, 4)
+
+
+@pytest.mark.parametrize("space", ["linear", "srgb"])
+def test_blend_space_is_the_space_of_the_antialiasing(shapes, space):
+    case = make_case(shapes, "threshold", 4, space)
+    chosen, residuals = choose_blend_space(rgba(case.original))
+    assert chosen == space, residuals
+
+
+def test_blur_is_detected_and_left_alone(shapes):
+    case = make_case(shapes, "blur", 4, "srgb")
+    assert fit_lowpass(case.original, case.filtered)[0]
+    plan = plan_recovery(rgba(case.original), rgba(case.filtered))
+    assert plan.strength == 0
+    result = aarecovery.recover(case.original, case.filtered, backend="numpy")
+    np.testing.assert_array_equal(result, case.filtered)
+    assert not fit_lowpass(case.original, filters.unsharp_mask(case.original))[0]
+
+
+def test_pointwise_filters_are_recognised(shapes):
+    case = make_case(shapes, "gradientmap", 4, "linear")
+    edges = np.ones(case.original.shape[:2], bool)
+    assert fit_pointwise(case.original, case.filtered, edges).consistency > 0.99
+    unsharp = make_case(shapes, "unsharp", 4, "linear")
+    assert fit_pointwise(unsharp.original, unsharp.filtered, edges).consistency < 0.9
+
+
+def test_paper_mode_is_the_reference_passes_exactly(shapes):
+    case = make_case(shapes, "posterize", 4, "linear")
+    o, f = rgba(case.original), rgba(case.filtered)
+    model = fit_blend_model(to_working_space(o), to_working_space(f), 0.1, 0.01)
+    same = fit_blend_model(to_working_space(o), to_working_space(f), 0.1, 0.01, strength=1.0)
+    np.testing.assert_array_equal(model.beta, same.beta)
+    paper = aarecovery.recover(case.original, case.filtered, backend="numpy", mode="paper")
+    explicit = aarecovery.recover(case.original, case.filtered, backend="numpy", mode="paper", blend_space="linear")
+    np.testing.assert_array_equal(paper, explicit)
+
+
+def test_safe_mode_tiled_equals_untiled():
+    scene = _scenes.render("astronaut", 64, 4)
+    case = make_case(scene, "gamma", 4, "linear")
+    whole = aarecovery.recover(case.original, case.filtered, backend="numpy")
+    tiled = aarecovery.recover(case.original, case.filtered, backend="numpy", tile_size=24)
+    np.testing.assert_array_equal(whole, tiled)
+
+
+def test_engine_compute_takes_the_mode(shapes):
+    case = make_case(shapes, "threshold", 4, "srgb")
+    engine = aarecovery.Engine("numpy")
+    engine.set_images(case.original, case.filtered)
+    safe = engine.recover()
+    assert engine.last_plan is not None and engine.last_plan.blend_space == "srgb"
+    np.testing.assert_array_equal(safe, aarecovery.recover(case.original, case.filtered, backend="numpy"))
+    paper = engine.recover(mode="paper")
+    assert engine.last_plan is None
+    np.testing.assert_array_equal(paper, aarecovery.recover(case.original, case.filtered, backend="numpy",
+                                                            mode="paper"))
+    with pytest.raises(aarecovery.InputError, match="'fast'"):
+        engine.compute(mode="fast")
