@@ -1,0 +1,71 @@
+"""Command lines, save rules and pair loading (no window, no GL)."""
+
+import shlex
+
+import numpy as np
+import pytest
+
+import aarecovery
+from aarecovery.cli import build_parser
+from aarecovery.viewer.saving import default_output_path, overwrite_question
+from aarecovery.viewer.settings import RecoverySettings, command_line, supported_modes
+from aarecovery.viewer.sources import PairSource, load_pair
+
+
+def parse(command):
+    """Parse each `aarecovery ...` step with the real command-line parser."""
+    parsed = []
+    for step in command.split(" && "):
+        words = shlex.split(step)
+        assert words[0] == "aarecovery"
+        parsed.append(build_parser().parse_args(words[1:]))
+    return parsed
+
+
+def test_command_line_reproduces_the_parameters():
+    settings = RecoverySettings.defaults().with_values(sigma_d=0.25, sigma_e=0.0199999995529, iterations=7)
+    (args,) = parse(command_line(PairSource("my photo.png", "f.png"), settings, "out dir/r.png"))
+    assert (args.original, args.filtered, args.output) == ("my photo.png", "f.png", "out dir/r.png")
+    assert (args.sigma_d, args.sigma_e, args.iterations) == (0.25, 0.02, 7)
+
+
+@pytest.mark.skipif(len(supported_modes()) < 2, reason="the engine has no mode switch")
+def test_command_line_selects_a_non_default_mode():
+    settings = RecoverySettings.defaults().with_values(mode=supported_modes()[1])
+    default = parse(command_line(PairSource("o.png", "f.png"), RecoverySettings.defaults(), "r.png"))[0]
+    changed = parse(command_line(PairSource("o.png", "f.png"), settings, "r.png"))[0]
+    assert vars(default) != vars(changed)
+
+
+def test_command_line_for_a_built_in_filter_writes_f_first():
+    source = PairSource("o.png", None, "posterize", {"steps": 5})
+    steps = command_line(source, RecoverySettings.defaults(), "r.png").split(" && ")
+    assert len(steps) == 2 and "posterize" in steps[0] and "steps" in steps[0]
+    assert "recover o.png r-filtered.png -o r.png" in steps[1]
+
+
+def test_overwrite_question_names_inputs(tmp_path):
+    original, filtered = tmp_path / "o.png", tmp_path / "f.png"
+    original.write_bytes(b"x")
+    filtered.write_bytes(b"y")
+    source = PairSource(str(original), str(filtered))
+    assert overwrite_question(str(tmp_path / "new.png"), source) is None
+    assert "ORIGINAL input" in overwrite_question(str(original), source)
+    assert "FILTERED input" in overwrite_question(str(tmp_path / "." / "f.png"), source)
+    (tmp_path / "other.png").write_bytes(b"z")
+    assert overwrite_question(str(tmp_path / "other.png"), source).endswith("exists. Replace it?")
+    assert default_output_path(source) == str(tmp_path / "f-recovered.png")
+
+
+def test_load_pair_reports_mismatched_sizes_with_file_names(tmp_path):
+    aarecovery.write_image(tmp_path / "o.png", np.zeros((8, 9, 3), np.uint8))
+    aarecovery.write_image(tmp_path / "f.png", np.zeros((8, 10, 3), np.uint8))
+    with pytest.raises(aarecovery.InputError, match="o.png is 9x8 but f.png is 10x8"):
+        load_pair(PairSource(str(tmp_path / "o.png"), str(tmp_path / "f.png")))
+
+
+def test_load_pair_with_a_built_in_filter(tmp_path):
+    ramp = np.tile(np.linspace(0, 255, 16).astype(np.uint8), (4, 1))
+    aarecovery.write_image(tmp_path / "o.png", ramp)
+    pair = load_pair(PairSource(str(tmp_path / "o.png"), None, "threshold", {"level": 0.5}))
+    assert pair.filtered.shape == ramp.shape and set(np.unique(pair.filtered)) == {0, 255}

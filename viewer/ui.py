@@ -1,0 +1,277 @@
+"""The viewer's ImGui widgets: the side panel, messages, the help overlay and dialogs.
+
+Each function draws one part for one frame and changes the app only through its methods and
+plain attributes, so that the same actions are reachable from keys, widgets and tests.
+"""
+
+import os
+
+from imgui_bundle import imgui
+
+from . import settings as settings_module
+from .keys import KEY_HELP, VIEW_MODES
+from .sources import filter_names, filter_parameters
+
+__all__ = ["draw_ui", "PANEL_WIDTH"]
+
+#: Width of the side panel in window units (scaled with the content scale).
+PANEL_WIDTH = 330.0
+
+_ERROR = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
+_INFO = imgui.ImVec4(0.6, 0.85, 1.0, 1.0)
+_DIM = imgui.ImVec4(0.65, 0.65, 0.65, 1.0)
+_FIXED = (imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize | imgui.WindowFlags_.no_collapse
+          | imgui.WindowFlags_.no_saved_settings)
+
+
+def _record(app, name):
+    """Remember where the last widget's frame is (window coordinates), for --bench and tests.
+
+    The item rectangle includes the label to the right; the frame (a slider's track) is the
+    item width from the left edge.
+    """
+    low, high = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+    app.widget_rects[name] = (low.x, low.y, min(high.x, low.x + imgui.calc_item_width()), high.y)
+
+
+def draw_ui(app):
+    """Draw every window of one frame."""
+    if app.panel_visible:
+        _panel(app)
+    _messages(app)
+    if app.help_visible:
+        _help(app)
+    _dialogs(app)
+
+
+# ---------------------------------------------------------------------------------- panel
+def _panel(app):
+    io = imgui.get_io()
+    imgui.set_next_window_pos(imgui.ImVec2(0, 0))
+    imgui.set_next_window_size(imgui.ImVec2(app.panel_width, io.display_size.y))
+    imgui.begin("aarecovery", None, _FIXED)
+    _files_section(app)
+    _parameters_section(app)
+    _view_section(app)
+    _actions_section(app)
+    _status_section(app)
+    imgui.end()
+
+
+def _path_row(app, label, attribute, browse_role):
+    changed, value = imgui.input_text(f"##{attribute}", getattr(app, attribute))
+    _record(app, attribute)
+    if changed:
+        setattr(app, attribute, value)
+    imgui.same_line()
+    if app.native_dialogs and imgui.button(f"...##{attribute}"):
+        app.browse(browse_role)
+    imgui.same_line()
+    imgui.text(label)
+
+
+def _files_section(app):
+    if not imgui.collapsing_header("Images", imgui.TreeNodeFlags_.default_open):
+        return
+    _path_row(app, "ORIGINAL", "original_field", "original")
+    names = filter_names()
+    if names:
+        if imgui.radio_button("FILTERED file", not app.use_builtin_filter):
+            app.use_builtin_filter = False
+        imgui.same_line()
+        if imgui.radio_button("built-in filter", app.use_builtin_filter):
+            app.use_builtin_filter = True
+    if app.use_builtin_filter and names:
+        index = names.index(app.filter_field) if app.filter_field in names else 0
+        changed, index = imgui.combo("filter", index, names)
+        if changed:
+            app.choose_filter(names[index])
+        for name, default, help_text, is_int in filter_parameters(app.filter_field):
+            value = app.filter_params_field.get(name, default)
+            if is_int:
+                _, value = imgui.input_int(name, int(value))
+            else:
+                _, value = imgui.input_float(name, float(value), 0.0, 0.0, "%.4g")
+            if imgui.is_item_hovered():
+                imgui.set_tooltip(help_text)
+            app.filter_params_field[name] = value
+            if imgui.is_item_deactivated_after_edit():
+                app.open_fields()
+    else:
+        _path_row(app, "FILTERED", "filtered_field", "filtered")
+    if imgui.button("Open (Ctrl+O)"):
+        app.open_fields()
+    _record(app, "open")
+    imgui.same_line()
+    imgui.text_colored(_DIM, "or drop files on the window")
+
+
+def _parameters_section(app):
+    if not imgui.collapsing_header("Recovery", imgui.TreeNodeFlags_.default_open):
+        return
+    s = app.settings
+    clamp = imgui.SliderFlags_.always_clamp
+    _, sigma_d = imgui.slider_float("sigma_d", s.sigma_d, *settings_module.SIGMA_D_RANGE, "%.4f",
+                                    clamp | imgui.SliderFlags_.logarithmic)
+    _record(app, "sigma_d")
+    _, sigma_e = imgui.slider_float("sigma_e", s.sigma_e, *settings_module.SIGMA_E_RANGE, "%.5f",
+                                    clamp | imgui.SliderFlags_.logarithmic)
+    _record(app, "sigma_e")
+    _, iterations = imgui.slider_int("iterations", s.iterations, *settings_module.ITERATIONS_RANGE, "%d", clamp)
+    _record(app, "iterations")
+    mode = s.mode
+    modes = settings_module.supported_modes()
+    if modes:
+        changed, index = imgui.combo("mode", modes.index(mode) if mode in modes else 0, list(modes))
+        _record(app, "mode")
+        mode = modes[index]
+    app.settings = s.with_values(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode)
+    if imgui.button("Paper defaults"):
+        app.settings = settings_module.RecoverySettings.defaults()
+    imgui.same_line()
+    imgui.text_colored(_DIM, "ctrl+click a slider to type")
+
+
+def _view_section(app):
+    if not imgui.collapsing_header("View", imgui.TreeNodeFlags_.default_open):
+        return
+    labels = [label for _, label, _ in VIEW_MODES]
+    keys = [key for key, _, _ in VIEW_MODES]
+    index = keys.index(app.view_mode)
+    changed, index = imgui.combo("view", index, [f"{i + 1}  {label}" for i, label in enumerate(labels)])
+    _record(app, "view")
+    if changed:
+        app.set_view_mode(keys[index])
+    if imgui.radio_button("compare with F", app.compare_with == "filtered"):
+        app.compare_with = "filtered"
+    imgui.same_line()
+    if imgui.radio_button("with O", app.compare_with == "original"):
+        app.compare_with = "original"
+    _, app.auto_flicker = imgui.checkbox("flicker (K)", app.auto_flicker)
+    imgui.same_line()
+    _, app.flicker_period = imgui.slider_float("##period", app.flicker_period, 0.1, 2.0, "every %.2f s")
+    _, app.difference_gain = imgui.slider_float("heat-map gain", app.difference_gain, 1.0, 64.0, "x%.1f",
+                                                imgui.SliderFlags_.logarithmic)
+    if imgui.button("Fit (F)"):
+        app.view.fit()
+    imgui.same_line()
+    if imgui.button("1:1 (Z)"):
+        app.view.one_to_one()
+    imgui.same_line()
+    imgui.text(f"zoom {app.view.zoom * 100:.4g}%")
+
+
+def _actions_section(app):
+    if not imgui.collapsing_header("Result", imgui.TreeNodeFlags_.default_open):
+        return
+    if imgui.button("Save R... (Ctrl+S)"):
+        app.start_save()
+    _record(app, "save")
+    imgui.same_line()
+    if imgui.button("Copy command line"):
+        app.copy_command_line()
+    _record(app, "copy")
+
+
+def _status_section(app):
+    imgui.separator()
+    for line in app.status_lines():
+        imgui.text_colored(_DIM, line)
+    imgui.text_colored(_DIM, "H or F1: keys")
+
+
+# ---------------------------------------------------------------------------------- overlays
+def _messages(app):
+    if not app.messages:
+        return
+    io = imgui.get_io()
+    width = min(560.0, io.display_size.x - app.panel_width - 20)
+    imgui.set_next_window_pos(imgui.ImVec2(app.panel_width + 10, 10))
+    imgui.set_next_window_size(imgui.ImVec2(max(200.0, width), 0))
+    imgui.begin("##messages", None, _FIXED | imgui.WindowFlags_.no_title_bar
+                | imgui.WindowFlags_.always_auto_resize)
+    for index, message in enumerate(list(app.messages)):
+        imgui.push_text_wrap_pos(imgui.get_cursor_pos_x() + width - 60)
+        imgui.text_colored(_ERROR if message.error else _INFO, message.text)
+        imgui.pop_text_wrap_pos()
+        imgui.same_line()
+        if imgui.small_button(f"x##message{index}"):
+            app.dismiss_message(message)
+    imgui.end()
+
+
+def _help(app):
+    io = imgui.get_io()
+    imgui.set_next_window_pos(imgui.ImVec2(io.display_size.x / 2, io.display_size.y / 2),
+                              imgui.Cond_.always, imgui.ImVec2(0.5, 0.5))
+    expanded, still_open = imgui.begin("Keys", True, imgui.WindowFlags_.always_auto_resize
+                                       | imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.no_saved_settings)
+    if expanded:
+        if imgui.begin_table("keys", 2):
+            for keys, action in KEY_HELP:
+                imgui.table_next_row()
+                imgui.table_next_column()
+                imgui.text_colored(_INFO, keys)
+                imgui.table_next_column()
+                imgui.text(action)
+            imgui.end_table()
+    imgui.end()
+    if not still_open:
+        app.help_visible = False
+
+
+def _dialogs(app):
+    if app.open_save_dialog:
+        imgui.open_popup("Save result")
+        app.open_save_dialog = False
+    if app.pending_overwrite is not None and not imgui.is_popup_open("Replace file?"):
+        imgui.open_popup("Replace file?")
+    if app.pending_drop is not None and not imgui.is_popup_open("Dropped file"):
+        imgui.open_popup("Dropped file")
+
+    flags = imgui.WindowFlags_.always_auto_resize
+    if imgui.begin_popup_modal("Save result", None, flags)[0]:
+        imgui.text("Write the recovered image R to:")
+        imgui.set_next_item_width(480)
+        if imgui.is_window_appearing():
+            imgui.set_keyboard_focus_here()
+        _, app.save_field = imgui.input_text("##save_path", app.save_field)
+        imgui.text_colored(_DIM, "the extension picks the format: .png .tif .npy .jpg .webp .bmp")
+        if imgui.button("Save") or imgui.is_key_pressed(imgui.Key.enter):
+            imgui.close_current_popup()
+            app.request_save(app.save_field)
+        imgui.same_line()
+        if app.native_dialogs and imgui.button("Browse..."):
+            app.browse("save")
+        imgui.same_line()
+        if imgui.button("Cancel") or imgui.is_key_pressed(imgui.Key.escape):
+            imgui.close_current_popup()
+        imgui.end_popup()
+
+    if imgui.begin_popup_modal("Replace file?", None, flags)[0]:
+        question = app.pending_overwrite[1] if app.pending_overwrite else ""
+        imgui.text_colored(_ERROR, question)
+        if imgui.button("Replace"):
+            imgui.close_current_popup()
+            app.confirm_overwrite()
+        imgui.same_line()
+        if imgui.button("Cancel") or imgui.is_key_pressed(imgui.Key.escape):
+            imgui.close_current_popup()
+            app.pending_overwrite = None
+        imgui.end_popup()
+
+    if imgui.begin_popup_modal("Dropped file", None, flags)[0]:
+        name = os.path.basename(app.pending_drop or "")
+        imgui.text(f"Use {name} as:")
+        if imgui.button("ORIGINAL"):
+            imgui.close_current_popup()
+            app.use_dropped_as("original")
+        imgui.same_line()
+        if imgui.button("FILTERED"):
+            imgui.close_current_popup()
+            app.use_dropped_as("filtered")
+        imgui.same_line()
+        if imgui.button("Cancel") or imgui.is_key_pressed(imgui.Key.escape):
+            imgui.close_current_popup()
+            app.pending_drop = None
+        imgui.end_popup()
