@@ -9,12 +9,14 @@ Every function takes images as NumPy arrays ``(H, W)`` or ``(H, W, C)`` with C i
 declared linear, row 0 at the top, straight alpha.
 """
 
+from . import filters
 from ._engine import BACKENDS, Engine, RecoveryMaps
 from ._errors import InputError
 from ._io import read_image, write_image
+from ._params import BLEND_SPACES, MODES
 from ._recover import recover
 
 __version__ = "0.1.0"
 
-__all__ = ["recover", "Engine", "RecoveryMaps", "InputError", "BACKENDS", "read_image", "write_image",
-           "__version__"]
+__all__ = ["recover", "Engine", "RecoveryMaps", "InputError", "read_image", "write_image", "filters",
+           "BACKENDS", "MODES", "BLEND_SPACES", "__version__"]

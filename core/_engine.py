@@ -39,6 +39,20 @@ class RecoveryMaps:
     NAMES = ("alpha", "beta", "edge_strength", "residual")
 
 
+def plan_for_pair(original, filtered, linear, params):
+    """The safe default's per-image decisions (:func:`aarecovery._safeguards.plan_recovery`).
+
+    The analysis reads only a central crop, so only the crop is converted to float: a
+    20000 x 20000 pair would otherwise take 13 GB just for the conversion.
+    """
+    from ._safeguards import _analysis_crop, plan_recovery
+    o_crop, f_crop = _analysis_crop(original), _analysis_crop(filtered)
+    return plan_recovery(to_rgba_float(o_crop, layout_of(o_crop, "original"), "original"),
+                         to_rgba_float(f_crop, layout_of(f_crop, "filtered"), "filtered"),
+                         linear_input=bool(linear), sigma_d=params.sigma_d, sigma_e=params.sigma_e,
+                         iterations=params.iterations)
+
+
 def _make_backend(backend, context):
     if backend not in BACKENDS:
         raise InputError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
@@ -148,12 +162,8 @@ class Engine:
         """The safe default's decisions for the loaded pair (computed once per parameter set)."""
         key = (params.sigma_d, params.sigma_e, params.iterations)
         if key not in self._plans:
-            from ._safeguards import plan_recovery
             original, o_layout, filtered, f_layout, linear = self._pair[:5]
-            self._plans[key] = plan_recovery(to_rgba_float(original, o_layout, "original"),
-                                             to_rgba_float(filtered, f_layout, "filtered"),
-                                             linear_input=linear, sigma_d=params.sigma_d,
-                                             sigma_e=params.sigma_e, iterations=params.iterations)
+            self._plans[key] = plan_for_pair(original, filtered, linear, params)
         return self._plans[key]
 
     def _require_images(self):

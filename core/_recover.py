@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from ._contract import check_same_size, check_values, layout_of, to_rgba_float
-from ._engine import Engine, RecoveryMaps
+from ._contract import check_same_size, check_values, layout_of
+from ._engine import Engine, RecoveryMaps, plan_for_pair
 from ._errors import InputError
 from ._params import Parameters, check_blend_space, check_mode
 
@@ -126,10 +126,7 @@ def recover(original, filtered, *, sigma_d=0.1, sigma_e=0.01, iterations=3, back
     check_values(filtered, f_layout, "filtered")
     if mode == "safe":
         # Global decisions on the whole image, before tiling, so that tiled == untiled.
-        from ._safeguards import plan_recovery
-        plan = plan_recovery(to_rgba_float(original, o_layout, "original"),
-                             to_rgba_float(filtered, f_layout, "filtered"), linear_input=bool(linear),
-                             sigma_d=params.sigma_d, sigma_e=params.sigma_e, iterations=params.iterations)
+        plan = plan_for_pair(original, filtered, linear, params)
         blend_space = blend_space or plan.blend_space
         params = Parameters(params.sigma_d, params.sigma_e, params.iterations, plan.strength)
         if plan.strength == 0 and not return_maps:
