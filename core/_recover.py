@@ -12,9 +12,11 @@ __all__ = ["recover", "halo_for", "tiles"]
 # Pixels per tile side on the NumPy backend: its passes hold about 40 float32 values per
 # pixel at once, so 512 x 512 keeps a tile near 50 MB and in cache-friendly pieces.
 NUMPY_TILE = 512
-# GL tiles are capped below the texture limit as well: a 4096 x 4096 tile keeps the
-# intermediate textures near 1 GB, and larger tiles gain no speed on llvmpipe.
-GL_TILE = 4096
+# GL tiles are capped below the texture limit as well: the passes keep about 110 bytes of
+# textures per pixel, so a 2048 x 2048 tile holds ~450 MB, and `aarecovery recover` on a
+# 4096 x 4096 RGB pair peaks at 1.2 GB in all (4096 tiles: 1.9 GB, measured). Larger tiles
+# gain no speed on llvmpipe.
+GL_TILE = 2048
 
 
 def halo_for(iterations):

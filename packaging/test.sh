@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Install everything the test suite needs on a fresh Debian machine, then run it.
+#
+#   bash packaging/test.sh [PYTEST ARGS...]
+#
+# As root it installs the Debian packages the tests drive for real (Mesa's EGL/llvmpipe for
+# the GL backend, Xvfb for the viewer window, gegl and gmic for the eval's peer tools,
+# debootstrap for the GIMP 3 sandbox) and builds or refreshes the GIMP 3 sandbox (a Debian
+# trixie root, cached outside the checkout). Without root it installs nothing system-wide and
+# says loudly what is missing; the tests that need it then fail in CI or skip with a message.
+# The Python side always goes into .venv in the checkout.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+DEBIAN_PACKAGES=(libegl1 libgl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth gegl gmic debootstrap)
+
+missing=()
+for package in "${DEBIAN_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "ok installed" || missing+=("$package")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+    if [ "$(id -u)" = 0 ]; then
+        echo "test.sh: installing ${missing[*]}"
+        export DEBIAN_FRONTEND=noninteractive
+        apt-get update -qq
+        apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+    else
+        echo "test.sh: WARNING: not root, so these Debian packages cannot be installed: ${missing[*]}" >&2
+        echo "test.sh: WARNING: the tests that need them will fail in CI or be skipped loudly" >&2
+    fi
+fi
+
+python=${PYTHON:-python3}
+if [ ! -x .venv/bin/python ]; then
+    "$python" -m venv .venv
+fi
+.venv/bin/python -m pip install -q --upgrade pip
+.venv/bin/python -m pip install -q -e '.[viewer,eval,test]'
+
+if [ "$(id -u)" = 0 ]; then
+    sh packaging/gimp-sandbox.sh
+else
+    echo "test.sh: WARNING: not root, so the GIMP 3 sandbox cannot be built; GIMP tests will skip loudly" >&2
+fi
+
+exec .venv/bin/python -m pytest "$@"
