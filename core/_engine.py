@@ -194,7 +194,7 @@ class Engine:
             plan = self._plan(params)
             self.last_plan = plan
             self._load_space(requested or plan.blend_space)
-            params = Parameters(sigma_d, sigma_e, iterations, plan.strength)
+            params = Parameters(sigma_d, sigma_e, iterations, plan.strength, plan.pure_colours)
         else:
             self.last_plan = None
             self._load_space(requested or "linear")

@@ -9,13 +9,13 @@ __all__ = ["NumpyBackend"]
 
 # The passes run on strips of rows: their ~40 temporary planes then stay in cache, which
 # made them twice as fast at 1920x1080 (measured). A strip carries a halo of
-# iterations + 1 rows (the dependency radius, as for tiles), so the result is the same as
-# over the whole image.
+# iterations + 1 rows (the dependency radius, as for tiles, see ``halo_for``), so the result
+# is the same as over the whole image.
 _STRIP_ROWS = 64
 _MODEL_FIELDS = ("alpha", "beta", "index_a", "index_b", "residual", "edge")
 
 
-def _recover_in_strips(original, filtered, params):
+def _recover_in_strips(original, filtered, params, blend_space):
     height = original.shape[0]
     halo = params.iterations + 1
     recovered = np.empty_like(filtered)
@@ -24,13 +24,15 @@ def _recover_in_strips(original, filtered, params):
         bottom = min(height, top + _STRIP_ROWS)
         start, stop = max(0, top - halo), min(height, bottom + halo)
         strip_o, strip_f = original[start:stop], filtered[start:stop]
-        model = fit_blend_model(strip_o, strip_f, params.sigma_d, params.sigma_e, params.strength)
+        model = fit_blend_model(strip_o, strip_f, params.sigma_d, params.sigma_e, params.strength,
+                                params.pure_colours, blend_space)
         result = strip_f
         for _ in range(params.iterations):
             result = jacobi_step(result, strip_f, model)
         inner = slice(top - start, top - start + bottom - top)
         recovered[top:bottom] = result[inner]
         columns.append([getattr(model, name)[inner] for name in _MODEL_FIELDS])
+    # The pure-colour fields only serve the Jacobi steps inside a strip; maps do not show them.
     return recovered, BlendModel(*(np.concatenate(parts) for parts in zip(*columns)))
 
 
@@ -49,7 +51,7 @@ class NumpyBackend:
         self._result = self._model = None
 
     def run(self, params, maps):
-        recovered, model = _recover_in_strips(self._original, self._filtered, params)
+        recovered, model = _recover_in_strips(self._original, self._filtered, params, self._space["blend_space"])
         self._result = from_working_space(recovered, self._filtered_rgba, filtered_work=self._filtered,
                                           **self._space)
         self._model = model

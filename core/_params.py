@@ -28,12 +28,18 @@ class Parameters:
     strength : float
         Multiplies the confidence ``beta``, in [0, 1]: the safe default's per-image repair
         strength (1 is the paper's method). Backends pass it to the model fit as a uniform.
+    pure_colours : PureColourPrior or None
+        The safe default's pure-colour extension for point-wise filters on hard-edged
+        content (``aarecovery._pure_colours``): the filter's table and O's flat colours,
+        which backends take as a small lookup texture and a uniform array. None (the
+        paper's method) leaves every pass as published.
     """
 
     sigma_d: float = 0.1
     sigma_e: float = 0.01
     iterations: int = 3
     strength: float = 1.0
+    pure_colours: object = None
 
     def __post_init__(self):
         for name in ("sigma_d", "sigma_e"):

@@ -24,9 +24,14 @@ def halo_for(iterations):
 
     The model fit and Sobel read a 3x3 neighbourhood (radius 1), and each Jacobi iteration
     reads R at the extreme positions, again within radius 1 of the pixel. R after k
-    iterations therefore depends on O and F within radius k + 1.
+    iterations therefore depends on O and F within radius k + 1. The safe default's
+    pure-colour test (``_pure_colours``) reads O around the extreme pixel, radius 2 for the
+    model; R after k iterations reads models within radius k - 1, so O within radius k + 1:
+    the same halo, except for maps alone (k = 0), whose model needs radius 2. Its
+    image-border test only fires at a tile's edge, which lies beyond what the pixels a tile
+    decides read.
     """
-    return iterations + 1
+    return max(iterations + 1, 2)
 
 
 def tiles(height, width, tile, halo):
@@ -130,7 +135,7 @@ def recover(original, filtered, *, sigma_d=0.1, sigma_e=0.01, iterations=3, back
         # Global decisions on the whole image, before tiling, so that tiled == untiled.
         plan = plan_for_pair(original, filtered, linear, params)
         blend_space = blend_space or plan.blend_space
-        params = Parameters(params.sigma_d, params.sigma_e, params.iterations, plan.strength)
+        params = Parameters(params.sigma_d, params.sigma_e, params.iterations, plan.strength, plan.pure_colours)
         if plan.strength == 0 and not return_maps:
             return filtered.copy()
     blend_space = blend_space or "linear"

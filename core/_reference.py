@@ -42,6 +42,7 @@ __all__ = [
     "from_working_space",
     "edge_strength",
     "fit_blend_model",
+    "fit_pure_colour_model",
     "jacobi_step",
     "recover_working",
 ]
@@ -69,6 +70,12 @@ class BlendModel:
         Distance ``d_p`` of the centre colour from its best blend, equation 2.
     edge : ndarray of float32, shape (H, W)
         Edge strength ``e_p`` from :func:`edge_strength`.
+    pure_a, pure_b : ndarray of bool, shape (H, W), or None
+        With a pure-colour prior (``aarecovery._pure_colours``): where the extreme was a thin
+        feature's partial colour, and the Jacobi step blends the fixed colour below instead
+        of R at the extreme pixel. None without a prior.
+    fixed_a, fixed_b : ndarray of float32, shape (H, W, 4), or None
+        The filtered pure colours (working space), meaningful where `pure_a` / `pure_b`.
     """
 
     alpha: np.ndarray
@@ -77,6 +84,10 @@ class BlendModel:
     index_b: np.ndarray
     residual: np.ndarray
     edge: np.ndarray
+    pure_a: np.ndarray = None
+    pure_b: np.ndarray = None
+    fixed_a: np.ndarray = None
+    fixed_b: np.ndarray = None
 
 
 def to_working_space(rgba, *, linear_input=False, blend_space="linear"):
@@ -226,7 +237,7 @@ def _principal_direction(colours):
     return x
 
 
-def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0):
+def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=None, blend_space="linear"):
     """Fit the two-colour blend model at every pixel of O (section 3.1) and its confidence.
 
     The GL pass of this name also writes the first Jacobi iterate, which it can form from
@@ -244,11 +255,19 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0):
     strength : float
         Multiplies the confidence ``beta`` (the safe default's per-image repair strength,
         see ``_safeguards.py``); 1 is the paper's method and leaves ``beta`` bit-identical.
+    prior : PureColourPrior, optional
+        The safe default's pure-colour extension for point-wise filters on hard-edged
+        content (:func:`fit_pure_colour_model`); None is the paper's method.
+    blend_space : {"linear", "srgb"}
+        The working space's colour space, needed only with `prior` (its table is on
+        sRGB-encoded values).
 
     Returns
     -------
     BlendModel
     """
+    if prior is not None:
+        return fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space)
     colours = _neighbours(_planes(original))
     edge = (_sobel_magnitude(colours) * _sobel_magnitude(_neighbours(_planes(filtered)))).astype(np.float32)
     # Where e_p == 0 beta is exactly 0 and the model unused: fit only the other pixels (most
@@ -267,18 +286,19 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0):
     return BlendModel(alpha, beta, index_a, index_b, residual, edge)
 
 
-def _fit_columns(colours, edge, sigma_d, sigma_e, strength):
-    """The fit on neighbourhood columns: 9 arrays (4, N) and edge strengths (N,)."""
+def _fit_extremes(colours, sigma_d):
+    """Extremes, coverage and residual on neighbourhood columns: 9 arrays (4, N)."""
     centre = colours[0]
     direction = _principal_direction(colours)
     reach = np.float32(3) * np.float32(sigma_d)
     # Extremes along the line through the centre among candidates within 3 sigma_d of it; the
     # centre starts as both (t = 0), and only a strictly larger t replaces, so the first of
     # equal candidates wins.
-    index_a = np.zeros(edge.shape, np.uint8)
-    index_b = np.zeros(edge.shape, np.uint8)
-    t_max = np.zeros_like(edge)
-    t_min = np.zeros_like(edge)
+    count = centre.shape[1:]
+    index_a = np.zeros(count, np.uint8)
+    index_b = np.zeros(count, np.uint8)
+    t_max = np.zeros(count, np.float32)
+    t_min = np.zeros(count, np.float32)
     colour_a, colour_b = centre.copy(), centre.copy()
     for i, colour in enumerate(colours[1:], start=1):
         offset = colour - centre
@@ -293,19 +313,117 @@ def _fit_columns(colours, edge, sigma_d, sigma_e, strength):
         np.copyto(index_b, i, where=lower)
         np.copyto(colour_a, colour, where=higher)
         np.copyto(colour_b, colour, where=lower)
+    alpha = _coverage(centre, colour_a, colour_b)
+    miss = alpha * colour_a + (1 - alpha) * colour_b - centre
+    residual = np.sqrt(_dot(miss, miss)).astype(np.float32)
+    return alpha, residual, index_a, index_b, colour_a, colour_b
+
+
+def _coverage(centre, colour_a, colour_b):
     span = colour_a - colour_b
     span_sq = _dot(span, span)
     defined = span_sq > _TINY
     alpha = np.where(defined, _dot(centre - colour_b, span) / np.where(defined, span_sq, 1), 0.5)
-    alpha = np.clip(alpha, 0, 1).astype(np.float32)
-    miss = alpha * colour_a + (1 - alpha) * colour_b - centre
-    residual = np.sqrt(_dot(miss, miss)).astype(np.float32)
+    return np.clip(alpha, 0, 1).astype(np.float32)
+
+
+def _confidence(residual, edge, sigma_d, sigma_e, strength):
     residual_ratio = residual / np.float32(sigma_d)
     edge_ratio = edge / np.float32(sigma_e)
     beta = np.exp(-residual_ratio * residual_ratio) * (1 - np.exp(-edge_ratio * edge_ratio))
     if strength != 1.0:
         beta = beta * np.float32(strength)
-    return alpha, beta.astype(np.float32), residual, index_a, index_b
+    return beta.astype(np.float32)
+
+
+def _fit_columns(colours, edge, sigma_d, sigma_e, strength):
+    """The fit on neighbourhood columns: 9 arrays (4, N) and edge strengths (N,)."""
+    alpha, residual, index_a, index_b, _, _ = _fit_extremes(colours, sigma_d)
+    return alpha, _confidence(residual, edge, sigma_d, sigma_e, strength), residual, index_a, index_b
+
+
+def fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space):
+    """:func:`fit_blend_model` with the pure colours of thin features (the safe default).
+
+    For point-wise filters on hard-edged content (see ``aarecovery._pure_colours`` for the
+    rule and its measurements): an extreme that is a thin feature's partial colour is
+    extended along the colour line to the colour cube, its filtered colour is taken from
+    the filter's table, and alpha is measured against the extended colours. The edge
+    strength uses O's gradient times the larger of F's gradient and the contrast of the
+    two filtered extremes, since a thin feature that the filter erased from F (a light
+    stroke thresholded away) leaves F flat where it must be restored; measured, this added
+    0.05 to the quick suite's mean error reduction on linear-light scenes.
+
+    Parameters
+    ----------
+    original, filtered : ndarray of float32, shape (H, W, 4)
+        O and F in the working space.
+    sigma_d, sigma_e, strength
+        As for :func:`fit_blend_model`.
+    prior : PureColourPrior
+    blend_space : {"linear", "srgb"}
+
+    Returns
+    -------
+    BlendModel
+        With `pure_a`, `pure_b`, `fixed_a` and `fixed_b` set.
+    """
+    from ._pure_colours import extend_extreme
+
+    height, width = original.shape[:2]
+    o_planes, f_planes = _planes(original), _planes(filtered)
+    colours = _neighbours(o_planes)
+    f_colours = _neighbours(f_planes)
+    original_gradient = _sobel_magnitude(colours).astype(np.float32)
+    filtered_gradient = _sobel_magnitude(f_colours).astype(np.float32)
+    shape = (height, width)
+    alpha = np.full(shape, 0.5, np.float32)
+    beta = np.zeros(shape, np.float32)
+    residual = np.zeros(shape, np.float32)
+    edge = np.zeros(shape, np.float32)
+    index_a = np.zeros(shape, np.uint8)
+    index_b = np.zeros(shape, np.uint8)
+    pure_a = np.zeros(shape, bool)
+    pure_b = np.zeros(shape, bool)
+    fixed_a = np.zeros(shape + (4,), np.float32)
+    fixed_b = np.zeros(shape + (4,), np.float32)
+    # Where O is flat, e_p is 0 whatever F does: nothing to fit.
+    fitted = original_gradient > 0
+    if fitted.any():
+        rows, cols = np.nonzero(fitted)
+        columns = [colour[:, fitted] for colour in colours]
+        col_alpha, col_residual, col_a, col_b, colour_a, colour_b = _fit_extremes(columns, sigma_d)
+        offsets = np.asarray(NEIGHBOUR_OFFSETS, dtype=np.int64)
+        padded_o = np.pad(o_planes, ((0, 0), (2, 2), (2, 2)), mode="edge")
+        palette = prior.palette_in(blend_space)
+
+        def at(planes, pad, row, col):
+            return planes[:, np.clip(row, -pad, height - 1 + pad) + pad, np.clip(col, -pad, width - 1 + pad) + pad]
+
+        def extend(index, far, near):
+            q_row, q_col = rows + offsets[index, 0], cols + offsets[index, 1]
+            border = (q_row <= 0) | (q_row >= height - 1) | (q_col <= 0) | (q_col >= width - 1)
+            around = [at(padded_o, 2, q_row + dy, q_col + dx) for dy, dx in NEIGHBOUR_OFFSETS]
+            filtered_far = f_planes[:, np.clip(q_row, 0, height - 1), np.clip(q_col, 0, width - 1)]
+            extended, pure, fixed = extend_extreme(far, near, around, filtered_far, border, palette, prior,
+                                                   blend_space)
+            return extended, pure, np.where(extended, fixed, filtered_far)
+
+        extended_a, pure_colour_a, start_a = extend(col_a, colour_a, colour_b)
+        extended_b, pure_colour_b, start_b = extend(col_b, colour_b, colour_a)
+        either = extended_a | extended_b
+        col_alpha = np.where(either, _coverage(columns[0], pure_colour_a, pure_colour_b), col_alpha)
+        contrast = np.sqrt(_dot(start_a - start_b, start_a - start_b))
+        col_edge = (original_gradient[fitted] * np.maximum(filtered_gradient[fitted], contrast)).astype(np.float32)
+        alpha[fitted] = col_alpha
+        residual[fitted] = col_residual
+        edge[fitted] = col_edge
+        beta[fitted] = _confidence(col_residual, col_edge, sigma_d, sigma_e, strength)
+        index_a[fitted], index_b[fitted] = col_a, col_b
+        pure_a[fitted], pure_b[fitted] = extended_a, extended_b
+        fixed_a[fitted] = np.where(extended_a, start_a, 0).T
+        fixed_b[fitted] = np.where(extended_b, start_b, 0).T
+    return BlendModel(alpha, beta, index_a, index_b, residual, edge, pure_a, pure_b, fixed_a, fixed_b)
 
 
 def _gather_indices(index, height, width):
@@ -342,20 +460,25 @@ def jacobi_step(recovered, filtered, model):
 
     at_a = gather(model.index_a)
     at_b = gather(model.index_b)
+    if model.pure_a is not None:
+        at_a = np.where(model.pure_a[..., None], model.fixed_a, at_a)
+        at_b = np.where(model.pure_b[..., None], model.fixed_b, at_b)
     alpha = model.alpha[..., None]
     beta = model.beta[..., None]
     return (beta * (alpha * at_a + (1 - alpha) * at_b) + (1 - beta) * filtered).astype(np.float32)
 
 
-def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1.0):
-    """Run every pass on working-space images (`strength` as in :func:`fit_blend_model`).
+def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1.0, prior=None,
+                    blend_space="linear"):
+    """Run every pass on working-space images (`strength`, `prior`, `blend_space` as in
+    :func:`fit_blend_model`).
 
     Returns
     -------
     recovered : ndarray of float32, shape (H, W, 4)
     model : BlendModel
     """
-    model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength)
+    model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space)
     recovered = filtered
     for _ in range(iterations):
         recovered = jacobi_step(recovered, filtered, model)

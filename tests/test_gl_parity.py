@@ -139,3 +139,49 @@ def test_borrowed_context_state_is_restored():
         assert not context.error or context.error == "GL_NO_ERROR"
     finally:
         context.release()
+
+
+@pytest.mark.parametrize("scene, filter_name, space", [("text", "threshold", "linear"), ("lines", "gamma", "srgb"),
+                                                       ("lines", "gradientmap", "linear")])
+def test_pure_colours_agree(gl_engine, scene, filter_name, space):
+    # The safe default's pure-colour extension (fit_pure_colour_model, jacobi_step with fixed
+    # colours) on thin features, 8-bit: the final R within 1/255, and the extension in use.
+    from aarecovery import _scenes
+    from aarecovery._groundtruth import make_case
+    case = make_case(_scenes.render(scene, 48, 4), filter_name, 4, space)
+    original = np.rint(case.original * 255).astype(np.uint8)
+    filtered = np.rint(case.filtered * 255).astype(np.uint8)
+    actual = aarecovery.recover(original, filtered, engine=gl_engine)
+    gl_engine.set_images(original, filtered)
+    gl_engine.compute()
+    assert gl_engine.last_plan.pure_colours is not None
+    expected = aarecovery.recover(original, filtered, backend="numpy")
+    assert np.abs(actual.astype(np.int64) - expected).max() <= 1
+    paper = aarecovery.recover(original, filtered, backend="numpy", mode="paper")
+    assert np.abs(expected.astype(np.int64) - paper).max() > 16
+    _, maps = aarecovery.recover(original, filtered, engine=gl_engine, return_maps=True)
+    _, expected_maps = aarecovery.recover(original, filtered, backend="numpy", return_maps=True)
+    np.testing.assert_allclose(maps.beta, expected_maps.beta, rtol=0, atol=1e-5)
+
+
+@pytest.mark.parametrize("mode", ["paper", "safe"])
+def test_block_passes_match_whole_image_passes(gl_engine, mode):
+    # The fit and inner Jacobi passes draw only blocks where the edge strength can be non-zero
+    # (F not flat; O not flat with pure colours). A few features in a large flat image, so that
+    # most blocks are skipped, must give the NumPy result everywhere.
+    from aarecovery._gl.backend import BLOCK_SIDE
+    from aarecovery._scenes import render
+    from aarecovery._groundtruth import make_case
+    scene = render("text", 48, 4)
+    case = make_case(scene, "threshold", 4, "linear")
+    original = np.full((160, 176, 3), 255, np.uint8)
+    filtered = np.full((160, 176, 3), 255, np.uint8)
+    original[70:70 + 48, 100:100 + 48] = np.rint(case.original[..., :3] * 255)
+    filtered[70:70 + 48, 100:100 + 48] = np.rint(case.filtered[..., :3] * 255)
+    original[20:23, 10:40] = 200  # a light stroke the threshold erased from F
+    actual = aarecovery.recover(original, filtered, engine=gl_engine, mode=mode)
+    counts = {name: count for name, (count, _) in gl_engine._impl._blocks.items()}
+    total = -(-160 // BLOCK_SIDE) * -(-176 // BLOCK_SIDE)
+    assert 0 < counts["filtered"] < total / 2 and 0 < counts["original"] < total / 2
+    expected = aarecovery.recover(original, filtered, backend="numpy", mode=mode)
+    assert np.abs(actual.astype(np.int64) - expected).max() <= 1

@@ -10,6 +10,14 @@ Passes (each has a NumPy twin of the same name in ``aarecovery._reference``):
 2. ``jacobi_step`` (iterations 2..n), the last one fused with ``from_working_space``.
 3. ``from_working_space`` alone only for 0 or 1 iterations.
 
+Only the blocks of 16 x 16 pixels where the edge strength can be non-zero are drawn by the
+fit and the inner Jacobi passes (``blocks.vert``): where F is not flat for the paper's
+model, where O is not flat with pure colours (whose edge strength does not need F's
+gradient). Elsewhere beta is 0 and R = F, which the textures hold from the moment the pair
+is loaded. On llvmpipe, which shades every
+covered fragment, this is what makes mostly flat results (threshold, posterize) fast; a GPU
+skips those pixels in the shader's early exit anyway.
+
 Colour conversion happens on fetch, in the shader (colour.glsl), for every bit depth.
 sRGB textures would decode 8-bit inputs for free, but llvmpipe's decode is off by up to
 1.2e-3 from the exact curve, and the fit's argmax and 3 sigma_d decisions turn such errors
@@ -35,7 +43,7 @@ EngineTexture = namedtuple("EngineTexture", "texture channel linear")
 
 _CONVERT_NONE, _CONVERT_DECODE, _CONVERT_ENCODE = 0, 1, 2
 _UNITS = {"original_image": 0, "filtered_image": 1, "model_map": 2, "previous_iterate": 3, "recovered_work": 3,
-          "original_work": 4, "filtered_work": 5}
+          "original_work": 4, "filtered_work": 5, "transfer_table": 6, "fixed_a_map": 7, "fixed_b_map": 8}
 # Where each map lives: (texture key, channel).
 _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("model", 3),
                  "edge_strength": ("edge", 0)}
@@ -52,6 +60,49 @@ def _texture_dtype(dtype):
 #: How a texture of 1 to 4 channels reads as straight RGBA: the texture unit expands grey
 #: and RGB for free, where a CPU expansion to RGBA cost more than the upload itself.
 _SWIZZLES = {1: "RRR1", 2: "RRRG", 3: "RGB1", 4: "RGBA"}
+BLOCK_SIDE = 16
+# Above this share of active blocks one full-screen triangle is cheaper than the blocks.
+_FULL_SCREEN_SHARE = 0.9
+
+
+def active_blocks(pixels, side=BLOCK_SIDE):
+    """Blocks of `side` x `side` pixels that hold a pixel whose 3x3 neighbourhood in F is not flat.
+
+    Parameters
+    ----------
+    pixels : ndarray, shape (H, W, C)
+        F as uploaded (any dtype): equal values here are equal in the working space too.
+    side : int
+
+    Returns
+    -------
+    ndarray of int32, shape (N, 2)
+        ``(column, row)`` block indices, row-major.
+    """
+    height, width = pixels.shape[:2]
+    touched = np.zeros((height, width), bool)
+    for channel in range(pixels.shape[2]):
+        plane = pixels[..., channel]
+        across = plane[:, 1:] != plane[:, :-1]
+        down = plane[1:] != plane[:-1]
+        touched[:, 1:] |= across
+        touched[:, :-1] |= across
+        touched[1:] |= down
+        touched[:-1] |= down
+    # A pixel is active when its 3x3 window holds a differing pair: grow by one pixel.
+    grown = touched.copy()
+    grown[1:] |= touched[:-1]
+    grown[:-1] |= touched[1:]
+    wide = grown.copy()
+    wide[:, 1:] |= grown[:, :-1]
+    wide[:, :-1] |= grown[:, 1:]
+    rows, columns = -(-height // side), -(-width // side)
+    padded = np.zeros((rows * side, columns * side), bool)
+    padded[:height, :width] = wide
+    active = padded.reshape(rows, side, columns, side).any(axis=(1, 3))
+    found = np.argwhere(active)
+    return np.ascontiguousarray(found[:, ::-1], dtype=np.int32)
+
 
 
 def _pixels(image, layout, dtype):
@@ -95,18 +146,21 @@ class GLBackend:
         self._key = None
         self._readback = None
         self._ran = None
+        self._blocks = {}
+        self._block_arrays = {}
 
     # -- programs ---------------------------------------------------------------------------
-    def _program(self, fragment, **defines):
+    def _program(self, fragment, vertex="fullscreen.vert", **defines):
         defines = {**self._defines, **defines}
-        key = (fragment, tuple(sorted(defines.items())))
+        key = (fragment, vertex, tuple(sorted(defines.items())))
         if key not in self._programs:
-            program = self.context.program(vertex_shader=load_source("fullscreen.vert"),
+            program = self.context.program(vertex_shader=load_source(vertex),
                                            fragment_shader=load_source(fragment, defines))
             for uniform, unit in _UNITS.items():
                 if uniform in program:
                     program[uniform] = unit
-            self._programs[key] = (program, self.context.vertex_array(program, []))
+            vertex_array = self.context.vertex_array(program, []) if vertex == "fullscreen.vert" else None
+            self._programs[key] = (program, vertex_array)
         return self._programs[key]
 
     # -- images -----------------------------------------------------------------------------
@@ -119,7 +173,9 @@ class GLBackend:
         else:
             input_mode = output_mode = _CONVERT_NONE
         self._defines = {"INPUT_CONVERT": input_mode, "OUTPUT_CONVERT": output_mode,
-                         "EXACT_UNTOUCHED": int(f_layout.dtype != np.uint8)}
+                         "EXACT_UNTOUCHED": int(f_layout.dtype != np.uint8),
+                         "WORK_IS_LINEAR": int(blend_space == "linear")}
+        self._blend_space = blend_space
         self._linear = dict.fromkeys(("original", "filtered", "result"), linear_input)
 
         def texture_dtype(layout):
@@ -132,12 +188,40 @@ class GLBackend:
             self._allocate(size, o_dtype, o_layout.channels, f_dtype, f_layout.channels)
             self._key = key
         t = self._textures
-        t["original"].write(_pixels(original, o_layout, o_dtype))
-        t["filtered"].write(_pixels(filtered, f_layout, f_dtype))
+        original_pixels = _pixels(original, o_layout, o_dtype)
+        filtered_pixels = _pixels(filtered, f_layout, f_dtype)
+        t["original"].write(original_pixels)
+        t["filtered"].write(filtered_pixels)
+        self._set_blocks({"filtered": active_blocks(filtered_pixels), "original": active_blocks(original_pixels)},
+                         size)
+        fb = self._framebuffers
         with self._passes():
-            self._draw(self._framebuffers["working"], "to_working_space.frag",
+            self._draw(fb["working"], "to_working_space.frag",
                        {"original_image": t["original"], "filtered_image": t["filtered"]})
+            # What the block passes never write: the unfitted model (alpha 0.5, beta 0),
+            # no edge, and R = F.
+            fb["model"].clear(0.5, 0.0, 0.0, 0.0)
+            fb["edge"].clear(0.0, 0.0, 0.0, 0.0)
+            self.context.copy_framebuffer(fb["iterate_a"], fb["filtered_work"])
+            self.context.copy_framebuffer(fb["iterate_b"], fb["filtered_work"])
         self._ran = None
+
+    def _set_blocks(self, block_sets, size):
+        """Keep instance buffers of active blocks: ``{name: (count, buffer)}``, where a count of
+        None means "draw the whole image" (almost every block is active)."""
+        for vertex_array in self._block_arrays.values():
+            vertex_array.release()
+        self._block_arrays = {}
+        for _, buffer in self._blocks.values():
+            if buffer is not None:
+                buffer.release()
+        self._blocks = {}
+        total = -(-size[0] // BLOCK_SIDE) * -(-size[1] // BLOCK_SIDE)
+        for name, blocks in block_sets.items():
+            if len(blocks) > _FULL_SCREEN_SHARE * total:
+                self._blocks[name] = (None, None)
+            else:
+                self._blocks[name] = (len(blocks), self.context.buffer(blocks.tobytes()) if len(blocks) else None)
 
     def _texture(self, size, components, dtype):
         texture = self.context.texture(size, components, dtype=dtype, alignment=1)
@@ -156,13 +240,22 @@ class GLBackend:
         t["filtered_work"] = self._texture(size, 4, "f4")
         t["model"] = self._texture(size, 4, "f4")
         t["edge"] = self._texture(size, 1, "f4")
+        t["fixed_a"] = self._texture(size, 4, "f4")
+        t["fixed_b"] = self._texture(size, 4, "f4")
+        t["transfer_table"] = self._texture((256, 1), 3, "f4")
         t["iterate_a"] = self._texture(size, 4, "f4")
         t["iterate_b"] = self._texture(size, 4, "f4")
         t["result"] = self._texture(size, 4, _texture_dtype(f_dtype))
         fb = self._framebuffers
         fb["working"] = self.context.framebuffer([t["original_work"], t["filtered_work"]])
+        fb["filtered_work"] = self.context.framebuffer([t["filtered_work"]])
+        fb["model"] = self.context.framebuffer([t["model"]])
+        fb["edge"] = self.context.framebuffer([t["edge"]])
         fb["fit"] = self.context.framebuffer([t["model"], t["iterate_a"]])
         fb["fit_maps"] = self.context.framebuffer([t["model"], t["iterate_a"], t["edge"]])
+        fb["fit_pure"] = self.context.framebuffer([t["model"], t["iterate_a"], t["fixed_a"], t["fixed_b"]])
+        fb["fit_pure_maps"] = self.context.framebuffer([t["model"], t["iterate_a"], t["edge"], t["fixed_a"],
+                                                        t["fixed_b"]])
         fb["iterate_a"] = self.context.framebuffer([t["iterate_a"]])
         fb["iterate_b"] = self.context.framebuffer([t["iterate_b"]])
         fb["result"] = self.context.framebuffer([t["result"]])
@@ -181,15 +274,28 @@ class GLBackend:
             if previous is not None:
                 previous.use()
 
-    def _draw(self, framebuffer, fragment, inputs, uniforms=None, **defines):
-        program, vertex_array = self._program(fragment, **defines)
+    def _draw(self, framebuffer, fragment, inputs, uniforms=None, blocks=None, **defines):
+        """One pass: over the whole image, or over the active blocks of the set `blocks` names."""
+        count, buffer = self._blocks.get(blocks, (None, None))
+        program, vertex_array = self._program(fragment, "fullscreen.vert" if count is None else "blocks.vert",
+                                              **defines)
         for name, value in (uniforms or {}).items():
             if name in program:
                 program[name] = value
         for uniform, texture in inputs.items():
             texture.use(_UNITS[uniform])
         framebuffer.use()
-        vertex_array.render(moderngl.TRIANGLES, vertices=3)
+        if count is None:
+            vertex_array.render(moderngl.TRIANGLES, vertices=3)
+            return
+        if count == 0:
+            return
+        program["image_size"] = self._key[0]
+        program["block_side"] = BLOCK_SIDE
+        key = (id(program), blocks)
+        if key not in self._block_arrays:
+            self._block_arrays[key] = self.context.vertex_array(program, [(buffer, "2i/i", "block")])
+        self._block_arrays[key].render(moderngl.TRIANGLES, vertices=6, instances=count)
 
     @_current
     def run(self, params, maps):
@@ -197,11 +303,30 @@ class GLBackend:
         sources = {"original_work": t["original_work"], "filtered_work": t["filtered_work"],
                    "filtered_image": t["filtered"]}
         n = params.iterations
+        prior = params.pure_colours
+        active = "filtered" if prior is None else "original"
+        pure = {"PURE_COLOURS": int(prior is not None)}
+        uniforms = {"sigma_d": params.sigma_d, "sigma_e": params.sigma_e, "strength": params.strength}
+        jacobi_inputs = {}
+        if prior is not None:
+            # The filter's table (3 KB) and the palette as uniforms: per run, as they belong
+            # to the plan, not to the loaded pair.
+            t["transfer_table"].write(np.ascontiguousarray(prior.table, np.float32))
+            palette = np.zeros((32, 3), np.float32)
+            colours = prior.palette_in(self._blend_space)
+            palette[:len(colours)] = colours
+            uniforms.update(table_key=prior.key_code, palette_size=len(colours),
+                            palette=[tuple(map(float, colour)) for colour in palette])
+            sources["transfer_table"] = t["transfer_table"]
+            jacobi_inputs = {"fixed_a_map": t["fixed_a"], "fixed_b_map": t["fixed_b"]}
         with self._passes():
             if n > 0 or maps:
-                self._draw(fb["fit_maps" if maps else "fit"], "fit_blend_model.frag", sources,
-                           {"sigma_d": params.sigma_d, "sigma_e": params.sigma_e, "strength": params.strength},
-                           MAPS=int(maps))
+                framebuffer = ("fit_pure" if prior is not None else "fit") + ("_maps" if maps else "")
+                # Pure colours restore thin features that the filter erased, where F is flat
+                # but O is not: those passes cover O's active blocks, not F's.
+                self._draw(fb[framebuffer], "fit_blend_model.frag", sources, uniforms, blocks=active,
+                           MAPS=int(maps), **(dict(FIXED_LOCATION=2 + int(maps), FIXED_LOCATION_B=3 + int(maps), **pure)
+                              if prior is not None else pure))
             if n == 0:
                 self._draw(fb["result"], "from_working_space.frag", sources, FROM_FILTERED=1)
             elif n == 1:
@@ -213,8 +338,9 @@ class GLBackend:
                     final = step == n
                     target = "result" if final else ("iterate_b" if previous == "iterate_a" else "iterate_a")
                     self._draw(fb[target], "jacobi_step.frag",
-                               {**sources, "model_map": t["model"], "previous_iterate": t[previous]},
-                               FINAL=int(final))
+                               {**sources, **jacobi_inputs, "model_map": t["model"],
+                                "previous_iterate": t[previous]},
+                               blocks=None if final else active, FINAL=int(final), **pure)
                     previous = target
         self._ran = {"maps": maps}
 
@@ -269,8 +395,10 @@ class GLBackend:
 
     @_current
     def _release_objects(self):
+        self._set_blocks({}, (1, 1))
         self._release_images()
         for program, vertex_array in self._programs.values():
-            vertex_array.release()
+            if vertex_array is not None:
+                vertex_array.release()
             program.release()
         self._programs = {}

@@ -47,8 +47,10 @@ def xvfb_display():
         _missing("Xvfb is not installed: apt-get install xvfb")
     read_end, write_end = os.pipe()
     # -displayfd: Xvfb picks a free display number and writes it to the pipe once it is ready.
+    # -noreset: an X server resets when its last client leaves, and a test connecting during
+    # that reset failed with "Failed to open display" (seen in about one run in three).
     server = subprocess.Popen([executable, "-displayfd", str(write_end), "-screen", "0", "1400x900x24",
-                               "-nolisten", "tcp"], pass_fds=(write_end,), stdout=subprocess.DEVNULL,
+                               "-nolisten", "tcp", "-noreset"], pass_fds=(write_end,), stdout=subprocess.DEVNULL,
                               stderr=subprocess.DEVNULL)
     os.close(write_end)
     with os.fdopen(read_end) as pipe:

@@ -13,6 +13,11 @@ layout(location = 1) out vec4 first_iterate;  // working space
 #if MAPS
 layout(location = 2) out vec4 edge_map;       // edge strength in .r
 #endif
+#if PURE_COLOURS
+#include "pure_colours.glsl"
+layout(location = FIXED_LOCATION) out vec4 fixed_a;      // f of the pure colour at extreme a
+layout(location = FIXED_LOCATION_B) out vec4 fixed_b;  // ... and at extreme b (the next location)
+#endif
 
 const float TINY = 1e-12;
 const float FAINT = 1e-30;
@@ -36,14 +41,25 @@ void main() {
     float filtered_gradient = sobel_magnitude(f);
     vec4 c[9];
     float edge = 0.0;
+#if PURE_COLOURS
+    // With pure colours, a thin feature that the filter erased leaves F flat where it must
+    // be restored: only a flat O means there is nothing to fit (see fit_pure_colour_model).
+    for (int i = 0; i < 9; ++i) c[i] = texelFetch(original_work, clamp_to_image(p + OFFSETS[i], size), 0);
+    float original_gradient = sobel_magnitude(c);
+    edge = original_gradient * filtered_gradient;
+    fixed_a = vec4(0.0);
+    fixed_b = vec4(0.0);
+    if (original_gradient == 0.0) {
+#else
     if (filtered_gradient > 0.0) {
         for (int i = 0; i < 9; ++i) c[i] = texelFetch(original_work, clamp_to_image(p + OFFSETS[i], size), 0);
         edge = sobel_magnitude(c) * filtered_gradient;
     }
-#if MAPS
-    edge_map = vec4(edge, 0.0, 0.0, 1.0);
-#endif
     if (edge == 0.0) {
+#endif
+#if MAPS
+        edge_map = vec4(edge, 0.0, 0.0, 1.0);
+#endif
         model = vec4(0.5, 0.0, 0.0, 0.0);
         first_iterate = f[0];
         return;
@@ -98,11 +114,28 @@ void main() {
     float alpha = span_sq > TINY ? clamp(dot(c[0] - c_b, span) / span_sq, 0.0, 1.0) : 0.5;
     vec4 miss = alpha * c_a + (1.0 - alpha) * c_b - c[0];
     float residual = sqrt(dot(miss, miss));
+    float code = float(9 * a + b);
+#if PURE_COLOURS
+    Extension ext_a = extend_extreme(c_a, c_b, p + OFFSETS[a], f_a, size);
+    Extension ext_b = extend_extreme(c_b, c_a, p + OFFSETS[b], f_b, size);
+    if (ext_a.extended || ext_b.extended) {
+        vec4 pure_span = ext_a.colour - ext_b.colour;
+        float pure_span_sq = dot(pure_span, pure_span);
+        alpha = pure_span_sq > TINY ? clamp(dot(c[0] - ext_b.colour, pure_span) / pure_span_sq, 0.0, 1.0) : 0.5;
+    }
+    if (ext_a.extended) { f_a = ext_a.filtered; fixed_a = ext_a.filtered; code += 81.0; }
+    if (ext_b.extended) { f_b = ext_b.filtered; fixed_b = ext_b.filtered; code += 162.0; }
+    vec4 contrast_vector = f_a - f_b;
+    edge = original_gradient * max(filtered_gradient, sqrt(dot(contrast_vector, contrast_vector)));
+#endif
+#if MAPS
+    edge_map = vec4(edge, 0.0, 0.0, 1.0);
+#endif
     float edge_ratio = edge / sigma_e;
     float residual_ratio = residual / sigma_d;
     float beta = exp(-residual_ratio * residual_ratio) * (1.0 - exp(-edge_ratio * edge_ratio));
     if (strength != 1.0) beta *= strength;
 
-    model = vec4(alpha, beta, float(9 * a + b), residual);
+    model = vec4(alpha, beta, code, residual);
     first_iterate = beta * (alpha * f_a + (1.0 - alpha) * f_b) + (1.0 - beta) * f[0];
 }

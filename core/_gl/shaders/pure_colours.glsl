@@ -1,0 +1,107 @@
+// Pure colours of thin features (the safe default, point-wise filters on hard-edged content).
+// Twin: extend_extreme and filtered_colour in aarecovery/_pure_colours.py, which explains
+// the rule and its measurements. Included by fit_blend_model.frag after working.glsl.
+
+uniform sampler2D transfer_table;  // 256 x 1: the filter's table, encoded output per key bin
+uniform int table_key;             // 0: each channel indexes its own column, 1: luma indexes all
+uniform vec3 palette[32];          // O's flat colours, opaque, in the working space
+uniform int palette_size;
+
+const float PALETTE_TOLERANCE = 0.03;
+const float LINE_TOLERANCE = 0.05;
+const float RIDGE_MARGIN = 0.1;
+const float EXPLAIN_TOLERANCE = 0.02;
+const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
+
+float table_at(float key, int channel) {
+    // Linear interpolation between bin centres, two fetches (no texture filtering: llvmpipe's
+    // filtering weights are not exact).
+    float position = clamp(key * 256.0 - 0.5, 0.0, 255.0);
+    int lower = min(int(floor(position)), 254);
+    float fraction = position - float(lower);
+    float below = texelFetch(transfer_table, ivec2(lower, 0), 0)[channel];
+    float above = texelFetch(transfer_table, ivec2(lower + 1, 0), 0)[channel];
+    return below + (above - below) * fraction;
+}
+
+// f of a premultiplied working-space colour, by the table.
+vec4 filtered_colour(vec4 colour) {
+    float coverage = colour.a;
+    vec3 straight = clamp(colour.rgb / (coverage > 0.0 ? coverage : 1.0), 0.0, 1.0);
+#if WORK_IS_LINEAR
+    vec3 encoded = linear_to_srgb(straight);
+#else
+    vec3 encoded = straight;
+#endif
+    vec3 keys = encoded;
+    if (table_key == 1) {
+        float luma = encoded.r * LUMA.r + encoded.g * LUMA.g + encoded.b * LUMA.b;
+        keys = vec3(luma);
+    }
+    vec3 out_colour = vec3(table_at(keys.r, 0), table_at(keys.g, 1), table_at(keys.b, 2));
+#if WORK_IS_LINEAR
+    vec3 decoded = srgb_to_linear(clamp(out_colour, 0.0, 1.0));
+#else
+    vec3 decoded = out_colour;
+#endif
+    return vec4(decoded * coverage, coverage);
+}
+
+// Both pixels lie on the colour line and are less extreme than `limit` along it.
+bool lower_pair(ivec2 first_at, ivec2 second_at, vec4 near, vec4 direction, float limit, ivec2 size) {
+    vec4 first = texelFetch(original_work, clamp_to_image(first_at, size), 0) - near;
+    vec4 second = texelFetch(original_work, clamp_to_image(second_at, size), 0) - near;
+    float t_first = dot(first, direction);
+    float t_second = dot(second, direction);
+    float reach_sq = LINE_TOLERANCE * LINE_TOLERANCE;
+    bool on_line = (dot(first, first) - t_first * t_first < reach_sq)
+                && (dot(second, second) - t_second * t_second < reach_sq);
+    return on_line && t_first < limit && t_second < limit;
+}
+
+struct Extension {
+    bool extended;
+    vec4 colour;    // the pure colour (the extreme itself where not extended)
+    vec4 filtered;  // f of it, where extended
+};
+
+// Is the extreme `far` at pixel q a thin feature's partial colour? If so, extend it along the
+// line from `near` to the colour cube.
+Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 size) {
+    Extension result = Extension(false, far, far);
+    vec4 span = far - near;
+    float len = sqrt(dot(span, span));
+    if (!(len > 1e-6)) return result;
+    if (q.x <= 0 || q.y <= 0 || q.x >= size.x - 1 || q.y >= size.y - 1) return result;
+    for (int i = 0; i < palette_size; ++i) {
+        vec3 miss = far.rgb - palette[i] * far.a;
+        if (!(miss.r * miss.r + miss.g * miss.g + miss.b * miss.b >= PALETTE_TOLERANCE * PALETTE_TOLERANCE))
+            return result;
+    }
+    vec4 explained = abs(filtered_colour(far) - filtered_far);
+    if (!(max(max(explained.r, explained.g), explained.b) < EXPLAIN_TOLERANCE)) return result;
+    vec4 direction = span / len;
+    float t_far = dot(far - near, direction);
+    float margin = RIDGE_MARGIN * len;
+    // Opposite pairs of q's neighbours, N/S, W/E, NW/SE, NE/SW, written out: indexing an
+    // array with a loop variable makes llvmpipe spill it to memory.
+    bool ridge = lower_pair(q + OFFSETS[1], q + OFFSETS[4], near, direction, t_far - margin, size)
+              || lower_pair(q + OFFSETS[2], q + OFFSETS[3], near, direction, t_far - margin, size)
+              || lower_pair(q + OFFSETS[5], q + OFFSETS[8], near, direction, t_far - margin, size)
+              || lower_pair(q + OFFSETS[6], q + OFFSETS[7], near, direction, t_far - margin, size);
+    if (!ridge) return result;
+    // Largest s >= 1 with near + s span inside the premultiplied cube 0 <= rgb <= alpha <= 1.
+    float reach = 1e6;
+    for (int c = 0; c < 4; ++c) {
+        float step = span[c] - (c < 3 ? span.a : 0.0);
+        float room_up = (c < 3 ? near.a : 1.0) - near[c];
+        float up = step > 1e-9 ? room_up / step : 1e6;
+        float down = span[c] < -1e-9 ? -near[c] / span[c] : 1e6;
+        reach = min(reach, min(up, down));
+    }
+    reach = max(reach, 1.0);
+    result.extended = true;
+    result.colour = near + reach * span;
+    result.filtered = filtered_colour(result.colour);
+    return result;
+}
