@@ -133,7 +133,7 @@ def recover(original, filtered, *, sigma_d=0.1, sigma_e=0.01, iterations=3, back
     check_values(filtered, f_layout, "filtered")
     if mode == "safe":
         # Global decisions on the whole image, before tiling, so that tiled == untiled.
-        plan = plan_for_pair(original, filtered, linear, params)
+        plan = plan_for_pair(original, filtered, linear)
         blend_space = blend_space or plan.blend_space
         params = Parameters(params.sigma_d, params.sigma_e, params.iterations, plan.strength, plan.pure_colours)
         if plan.strength == 0 and not return_maps:
