@@ -65,44 +65,56 @@ BLOCK_SIDE = 16
 _FULL_SCREEN_SHARE = 0.9
 
 
-def active_blocks(pixels, side=BLOCK_SIDE):
-    """Blocks of `side` x `side` pixels that hold a pixel whose 3x3 neighbourhood in F is not flat.
+def active_blocks(pixels, side=BLOCK_SIDE, margin=2):
+    """Blocks of `side` x `side` pixels whose surroundings are not flat.
+
+    A block is active when a pixel that differs from a neighbour lies in it or within
+    `margin` pixels of it. With a margin of 2, every pixel whose 3x3 window is not flat
+    (margin 1) and every neighbour such a pixel gathers in a Jacobi step (1 more) lies in an
+    active block, so the block passes write every value any pass reads, and the rest of the
+    image needs only the unfitted model.
 
     Parameters
     ----------
-    pixels : ndarray, shape (H, W, C)
-        F as uploaded (any dtype): equal values here are equal in the working space too.
-    side : int
+    pixels : ndarray, shape (H, W, C), C-contiguous
+        An image as uploaded (any dtype): equal values here are equal in the working space.
+    side, margin : int
 
     Returns
     -------
     ndarray of int32, shape (N, 2)
         ``(column, row)`` block indices, row-major.
     """
-    height, width = pixels.shape[:2]
-    touched = np.zeros((height, width), bool)
-    for channel in range(pixels.shape[2]):
-        plane = pixels[..., channel]
-        across = plane[:, 1:] != plane[:, :-1]
-        down = plane[1:] != plane[:-1]
-        touched[:, 1:] |= across
-        touched[:, :-1] |= across
-        touched[1:] |= down
-        touched[:-1] |= down
-    # A pixel is active when its 3x3 window holds a differing pair: grow by one pixel.
-    grown = touched.copy()
-    grown[1:] |= touched[:-1]
-    grown[:-1] |= touched[1:]
-    wide = grown.copy()
-    wide[:, 1:] |= grown[:, :-1]
-    wide[:, :-1] |= grown[:, 1:]
+    height, width, channels = pixels.shape
+    # Rows of interleaved values, compared C values apart: contiguous work, no per-channel
+    # strided views (3x faster at 4096 x 4096). A pixel differs where any of its values does,
+    # so blocks and margins are simply C times wider in values.
+    values = pixels.reshape(height, width * channels)
     rows, columns = -(-height // side), -(-width // side)
-    padded = np.zeros((rows * side, columns * side), bool)
-    padded[:height, :width] = wide
-    active = padded.reshape(rows, side, columns, side).any(axis=(1, 3))
+    touched = np.zeros((rows * side, columns * side * channels), bool)
+    across = values[:, channels:] != values[:, :-channels]
+    down = values[1:] != values[:-1]
+    touched[:height, channels:width * channels] |= across
+    touched[:height, :width * channels - channels] |= across
+    touched[1:height, :width * channels] |= down
+    touched[:height - 1, :width * channels] |= down
+    cells = touched.reshape(rows, side, columns, side * channels)
+    edge = margin * channels
+    active = cells.any(axis=(1, 3))
+    # A differing pixel within `margin` of a block's side also wakes the block beyond it.
+    active[:-1] |= cells[1:, :margin].any(axis=(1, 3))
+    active[1:] |= cells[:-1, -margin:].any(axis=(1, 3))
+    active[:, :-1] |= cells[:, :, 1:, :edge].any(axis=(1, 3))
+    active[:, 1:] |= cells[:, :, :-1, -edge:].any(axis=(1, 3))
+    corners = {(-1, -1): cells[:, :margin, :, :edge], (-1, 1): cells[:, :margin, :, -edge:],
+               (1, -1): cells[:, -margin:, :, :edge], (1, 1): cells[:, -margin:, :, -edge:]}
+    for (dy, dx), corner in corners.items():
+        # The corner of block (r, c) towards (r + dy, c + dx) wakes that diagonal neighbour.
+        hit = corner.any(axis=(1, 3))
+        active[max(0, dy):rows + min(0, dy), max(0, dx):columns + min(0, dx)] |= \
+            hit[max(0, -dy):rows - max(0, dy), max(0, -dx):columns - max(0, dx)]
     found = np.argwhere(active)
     return np.ascontiguousarray(found[:, ::-1], dtype=np.int32)
-
 
 
 def _pixels(image, layout, dtype):
@@ -192,32 +204,47 @@ class GLBackend:
         filtered_pixels = _pixels(filtered, f_layout, f_dtype)
         t["original"].write(original_pixels)
         t["filtered"].write(filtered_pixels)
-        self._set_blocks({"filtered": active_blocks(filtered_pixels), "original": active_blocks(original_pixels)},
-                         size)
-        fb = self._framebuffers
+        # O's blocks are needed only with pure colours: found when first asked for.
+        self._original_pixels = original_pixels
+        self._set_blocks({"filtered": active_blocks(filtered_pixels)}, size)
+        self._model_blocks = "stale"
         with self._passes():
-            self._draw(fb["working"], "to_working_space.frag",
+            self._draw(self._framebuffers["working"], "to_working_space.frag",
                        {"original_image": t["original"], "filtered_image": t["filtered"]})
-            # What the block passes never write: the unfitted model (alpha 0.5, beta 0),
-            # no edge, and R = F.
-            fb["model"].clear(0.5, 0.0, 0.0, 0.0)
-            fb["edge"].clear(0.0, 0.0, 0.0, 0.0)
-            self.context.copy_framebuffer(fb["iterate_a"], fb["filtered_work"])
-            self.context.copy_framebuffer(fb["iterate_b"], fb["filtered_work"])
         self._ran = None
 
-    def _set_blocks(self, block_sets, size):
+    def _prepare_blocks(self, name):
+        """Make sure block set `name` exists, and that outside it the model reads as unfitted.
+
+        The block passes write the model, the iterates and the edge map only inside their
+        blocks; the final full-image pass reads the model everywhere (beta 0 must mean R = F
+        there), and the edge map is read back everywhere. Iterates outside the blocks are
+        never read (see :func:`active_blocks`).
+        """
+        if name not in self._blocks:
+            self._set_blocks({name: active_blocks(self._original_pixels)}, self._key[0], keep=True)
+        count = self._blocks[name][0]
+        if count is not None and self._model_blocks != name:
+            self._framebuffers["model"].clear(0.5, 0.0, 0.0, 0.0)
+            self._framebuffers["edge"].clear(0.0, 0.0, 0.0, 0.0)
+        self._model_blocks = name if count is not None else None
+
+    def _set_blocks(self, block_sets, size, keep=False):
         """Keep instance buffers of active blocks: ``{name: (count, buffer)}``, where a count of
-        None means "draw the whole image" (almost every block is active)."""
-        for vertex_array in self._block_arrays.values():
-            vertex_array.release()
-        self._block_arrays = {}
-        for _, buffer in self._blocks.values():
-            if buffer is not None:
-                buffer.release()
-        self._blocks = {}
+        None means "draw the whole image" (almost every block is active). With `keep`, add
+        to the sets already made for this pair instead of replacing them."""
+        if not keep:
+            for vertex_array in self._block_arrays.values():
+                vertex_array.release()
+            self._block_arrays = {}
+            for _, buffer in self._blocks.values():
+                if buffer is not None:
+                    buffer.release()
+            self._blocks = {}
         total = -(-size[0] // BLOCK_SIDE) * -(-size[1] // BLOCK_SIDE)
         for name, blocks in block_sets.items():
+            if name in self._blocks:
+                continue
             if len(blocks) > _FULL_SCREEN_SHARE * total:
                 self._blocks[name] = (None, None)
             else:
@@ -305,6 +332,7 @@ class GLBackend:
         n = params.iterations
         prior = params.pure_colours
         active = "filtered" if prior is None else "original"
+        self._prepare_blocks(active)
         pure = {"PURE_COLOURS": int(prior is not None)}
         uniforms = {"sigma_d": params.sigma_d, "sigma_e": params.sigma_e, "strength": params.strength}
         jacobi_inputs = {}
@@ -329,12 +357,11 @@ class GLBackend:
                               if prior is not None else pure))
             if n == 0:
                 self._draw(fb["result"], "from_working_space.frag", sources, FROM_FILTERED=1)
-            elif n == 1:
-                self._draw(fb["result"], "from_working_space.frag",
-                           {**sources, "recovered_work": t["iterate_a"]}, FROM_FILTERED=0)
             else:
-                previous = "iterate_a"
-                for step in range(2, n + 1):
+                # R1 from R0 = F is the fit's first iterate; with one iteration the last pass
+                # forms it again, reading F itself, since outside the blocks no iterate is written.
+                previous = "iterate_a" if n > 1 else "filtered_work"
+                for step in range(2 if n > 1 else 1, n + 1):
                     final = step == n
                     target = "result" if final else ("iterate_b" if previous == "iterate_a" else "iterate_a")
                     self._draw(fb[target], "jacobi_step.frag",
