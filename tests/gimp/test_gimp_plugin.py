@@ -199,6 +199,7 @@ def build_cases(workdir, inside):
 
 OUT_OF_PROCESS = ("layer-rgb8", "layer-rgb8-feathered-selection", "filter-threshold-rgba8",
                   "filter-unsharp-float", "error-offset-layer")
+NO_GL = ("layer-rgb8", "filter-threshold-rgba8")
 
 
 # ---- running GIMP ----------------------------------------------------------------------------
@@ -230,7 +231,10 @@ def gimp_runs():
             runs = {}
             for mode, env, names in (
                     ("in-process", {"PYTHONPATH": sandbox.SITE}, None),
-                    ("subprocess", {}, OUT_OF_PROCESS)):
+                    ("subprocess", {}, OUT_OF_PROCESS),
+                    # No EGL vendor and no display: GL cannot start inside GIMP.
+                    ("no-gl", {"PYTHONPATH": sandbox.SITE, "__EGL_VENDOR_LIBRARY_FILENAMES": "/nonexistent.json"},
+                     NO_GL)):
                 run_dir = workdir / mode
                 run_dir.mkdir()
                 chosen = [c for c in cases if names is None or c["name"] in names]
@@ -323,6 +327,14 @@ def test_in_process(gimp_runs, name):
     result = check_case(gimp_runs["in-process"], name)
     assert result["runner"] == "in-process"
     assert result["backend"] in ("gl", "numpy")
+
+
+@pytest.mark.parametrize("name", NO_GL)
+def test_numpy_fallback_when_gl_cannot_start(gimp_runs, name):
+    # The same pixels from the NumPy backend; the in-process run above had GL.
+    result = check_case(gimp_runs["no-gl"], name)
+    assert result["backend"] == "numpy", result
+    assert gimp_runs["in-process"]["results"][name]["backend"] == "gl"
 
 
 @pytest.mark.parametrize("name", [n for n in OUT_OF_PROCESS if n in CASE_NAMES])
