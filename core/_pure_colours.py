@@ -23,6 +23,12 @@ filtered directly:
 * Coverage ``alpha`` is re-measured against the extended colours, and the Jacobi step
   blends the fixed filtered colours in place of ``R`` at the extreme pixels.
 
+* Tone mapping and histogram equalization are not functions of each channel or of luma on
+  colour content: they map luma (equalization, encoded values) or luminance (tone mapping,
+  linear light) and scale the colour with it. The scale keys (:data:`SCALE_KEYS`,
+  :func:`scale_transfer`) are that form; with them the extension covers those filters
+  (quick suite: tonemap on text/lines 0.39-0.52 -> 0.72-0.96, equalize 0.37-0.47 -> 0.81-0.90).
+
 * The table must be monotone (:func:`is_monotone`): tables that match colour to grey or a
   hue swap by coincidence are not, and extending with them lost up to 7.9 dB (chart).
 
@@ -42,7 +48,8 @@ import numpy as np
 
 from ._colour import linear_to_srgb, srgb_to_linear
 
-__all__ = ["PureColourPrior", "PALETTE_SIZE", "palette_of", "is_monotone", "filtered_colour", "extend_extreme"]
+__all__ = ["PureColourPrior", "PALETTE_SIZE", "palette_of", "is_monotone", "filtered_colour", "extend_extreme",
+           "scale_transfer", "SCALE_KEYS"]
 
 #: Most palette colours kept (a uniform array in the GL pass).
 PALETTE_SIZE = 32
@@ -59,8 +66,14 @@ RIDGE_MARGIN = 0.1
 # The table must reproduce F at the observed extreme within this (working space).
 EXPLAIN_TOLERANCE = 0.02
 #: Table keys for which the extension is used (see the module notes).
-EXTENSION_KEYS = ("channel", "luma")
-_KEY_CODES = {"channel": 0, "luma": 1}
+EXTENSION_KEYS = ("channel", "luma", "luma_scale", "luminance_scale")
+_KEY_CODES = {"channel": 0, "luma": 1, "luma_scale": 2, "luminance_scale": 3}
+#: Keys whose table maps a luma to a new luma and scales the colour with it (keeping hue):
+#: ``"luma_scale"`` on encoded values (histogram equalization), ``"luminance_scale"`` on
+#: linear light (tone mapping). Column 0 of the table holds the mapped value; black (key
+#: 0) maps to that grey.
+SCALE_KEYS = ("luma_scale", "luminance_scale")
+_SCALE_BLACK = 1e-6
 _LUMA = np.array([0.2126, 0.7152, 0.0722], np.float32)
 # (i, j) pairs of opposite neighbours as indices into NEIGHBOUR_OFFSETS.
 OPPOSITE_PAIRS = ((1, 4), (2, 3), (5, 8), (6, 7))
@@ -72,8 +85,10 @@ class PureColourPrior:
 
     Attributes
     ----------
-    key : {"channel", "luma"}
-        How :attr:`table` is indexed: each channel of the encoded colour, or its luma.
+    key : {"channel", "luma", "luma_scale", "luminance_scale"}
+        How :attr:`table` is indexed: each channel of the encoded colour, or its luma; the
+        scale keys map luma (encoded) or luminance (linear) and scale colour with it
+        (:func:`scale_transfer`).
     table : ndarray of float32, shape (256, 3)
         Encoded output colour per bin of the key; read with linear interpolation between
         bin centres ``(i + 0.5) / 256``.
@@ -87,7 +102,7 @@ class PureColourPrior:
 
     @property
     def key_code(self):
-        """int: 0 for ``"channel"``, 1 for ``"luma"`` (the GL pass's uniform)."""
+        """int: 0 ``"channel"``, 1 ``"luma"``, 2 ``"luma_scale"``, 3 ``"luminance_scale"`` (GL uniform)."""
         return _KEY_CODES[self.key]
 
     def palette_in(self, blend_space):
@@ -159,6 +174,41 @@ def _dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
 
 
+def _table_at(column, keys):
+    """Linear interpolation of a table column between bin centres ``(i + 0.5) / 256``."""
+    position = np.clip(keys * np.float32(256) - np.float32(0.5), 0, 255).astype(np.float32)
+    lower = np.minimum(np.floor(position).astype(np.intp), 254)
+    fraction = position - lower.astype(np.float32)
+    below, above = column[lower], column[lower + 1]
+    return below + (above - below) * fraction
+
+
+def scale_transfer(encoded, key, table):
+    """A scale key's ``f``: map the luma (or luminance) by the table, scale colour with it.
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (3, N)
+        sRGB-encoded colour planes.
+    key : {"luma_scale", "luminance_scale"}
+    table : ndarray of float32, shape (256, 3)
+        Column 0: the mapped luma (encoded) or luminance (linear) per bin.
+
+    Returns
+    -------
+    ndarray of float32, shape (3, N)
+        Encoded ``f(encoded)``, clipped to [0, 1].
+    """
+    values = srgb_to_linear(encoded.T).T if key == "luminance_scale" else encoded
+    values = values.astype(np.float32)
+    luma = values[0] * _LUMA[0] + values[1] * _LUMA[1] + values[2] * _LUMA[2]
+    mapped = _table_at(table[:, 0], luma).astype(np.float32)
+    lit = luma > np.float32(_SCALE_BLACK)
+    ratio = mapped / np.where(lit, luma, np.float32(1))
+    out = np.clip(np.where(lit, values * ratio, mapped), 0, 1).astype(np.float32)
+    return (linear_to_srgb(out.T).T if key == "luminance_scale" else out).astype(np.float32)
+
+
 def filtered_colour(colour, prior, blend_space):
     """``f`` of working-space colours, by the prior's table.
 
@@ -178,6 +228,10 @@ def filtered_colour(colour, prior, blend_space):
     visible = alpha > 0
     straight = np.clip(colour[:3] / np.where(visible, alpha, np.float32(1)), 0, 1).astype(np.float32)
     encoded = linear_to_srgb(straight.T).T if blend_space == "linear" else straight
+    if prior.key in SCALE_KEYS:
+        out = scale_transfer(encoded.astype(np.float32), prior.key, prior.table)
+        decoded = srgb_to_linear(out.T).T if blend_space == "linear" else out
+        return np.concatenate([decoded * alpha, alpha[None]], axis=0).astype(np.float32)
     if prior.key == "luma":
         keys = np.broadcast_to(encoded[0] * _LUMA[0] + encoded[1] * _LUMA[1] + encoded[2] * _LUMA[2],
                                encoded.shape)

@@ -142,7 +142,8 @@ def test_borrowed_context_state_is_restored():
 
 
 @pytest.mark.parametrize("scene, filter_name, space", [("text", "threshold", "linear"), ("lines", "gamma", "srgb"),
-                                                       ("lines", "gradientmap", "linear")])
+                                                       ("lines", "gradientmap", "linear"),
+                                                       ("lines", "tonemap", "srgb"), ("lines", "equalize", "srgb")])
 def test_pure_colours_agree(gl_engine, scene, filter_name, space):
     # The safe default's pure-colour extension (fit_pure_colour_model, jacobi_step with fixed
     # colours) on thin features, 8-bit: the final R within 1/255, and the extension in use.
@@ -155,6 +156,9 @@ def test_pure_colours_agree(gl_engine, scene, filter_name, space):
     gl_engine.set_images(original, filtered)
     gl_engine.compute()
     assert gl_engine.last_plan.pure_colours is not None
+    # Tone mapping and equalization scale colour with a mapped luminance / luma (table keys 3, 2).
+    assert gl_engine.last_plan.pure_colours.key == {"tonemap": "luminance_scale", "equalize": "luma_scale"}.get(
+        filter_name, gl_engine.last_plan.pure_colours.key)
     expected = aarecovery.recover(original, filtered, backend="numpy")
     assert np.abs(actual.astype(np.int64) - expected).max() <= 1
     paper = aarecovery.recover(original, filtered, backend="numpy", mode="paper")

@@ -3,7 +3,9 @@
 // the rule and its measurements. Included by fit_blend_model.frag after working.glsl.
 
 uniform sampler2D transfer_table;  // 256 x 1: the filter's table, encoded output per key bin
-uniform int table_key;             // 0: each channel indexes its own column, 1: luma indexes all
+uniform int table_key;             // 0: each channel indexes its own column, 1: luma indexes all,
+                                   // 2/3: luma (encoded) / luminance (linear) mapped by column 0,
+                                   // colour scaled with it (scale_transfer)
 uniform vec3 palette[32];          // O's flat colours, opaque, in the working space
 uniform int palette_size;
 
@@ -33,12 +35,22 @@ vec4 filtered_colour(vec4 colour) {
 #else
     vec3 encoded = straight;
 #endif
-    vec3 keys = encoded;
-    if (table_key == 1) {
-        float luma = encoded.r * LUMA.r + encoded.g * LUMA.g + encoded.b * LUMA.b;
-        keys = vec3(luma);
+    vec3 out_colour;
+    if (table_key >= 2) {
+        vec3 values = table_key == 3 ? srgb_to_linear(encoded) : encoded;
+        float luma = values.r * LUMA.r + values.g * LUMA.g + values.b * LUMA.b;
+        float mapped = table_at(luma, 0);
+        vec3 scaled = luma > 1e-6 ? values * (mapped / luma) : vec3(mapped);
+        scaled = clamp(scaled, 0.0, 1.0);
+        out_colour = table_key == 3 ? linear_to_srgb(scaled) : scaled;
+    } else {
+        vec3 keys = encoded;
+        if (table_key == 1) {
+            float luma = encoded.r * LUMA.r + encoded.g * LUMA.g + encoded.b * LUMA.b;
+            keys = vec3(luma);
+        }
+        out_colour = vec3(table_at(keys.r, 0), table_at(keys.g, 1), table_at(keys.b, 2));
     }
-    vec3 out_colour = vec3(table_at(keys.r, 0), table_at(keys.g, 1), table_at(keys.b, 2));
 #if WORK_IS_LINEAR
     vec3 decoded = srgb_to_linear(clamp(out_colour, 0.0, 1.0));
 #else
