@@ -94,11 +94,25 @@ class PureColourPrior:
         bin centres ``(i + 0.5) / 256``.
     palette : ndarray of float32, shape (N, 3), N <= PALETTE_SIZE
         sRGB-encoded flat colours of O.
+    key_low, key_high : ndarray of float32, shape (3,), optional
+        The key range O shows (bin centres of the table's first and last filled bins, per
+        column; the scale keys use column 0). Beyond it the table is extrapolated
+        (:func:`extrapolate_table`); an extreme whose key lies at an end of the range (within
+        :data:`RANGE_TOLERANCE`) is read with its keys clamped to the range, as before the
+        extrapolation (see :func:`extend_extreme`). Default: no clamping.
     """
 
     key: str
     table: np.ndarray
     palette: np.ndarray
+    key_low: np.ndarray = None
+    key_high: np.ndarray = None
+
+    def key_range(self):
+        """Observed key range (bin centres of the first and last filled bins), each shape (3,)."""
+        low = np.zeros(3, np.float32) if self.key_low is None else np.asarray(self.key_low, np.float32)
+        high = np.ones(3, np.float32) if self.key_high is None else np.asarray(self.key_high, np.float32)
+        return low, high
 
     @property
     def key_code(self):
@@ -209,7 +223,27 @@ def scale_transfer(encoded, key, table):
     return (linear_to_srgb(out.T).T if key == "luminance_scale" else out).astype(np.float32)
 
 
-def filtered_colour(colour, prior, blend_space):
+def _encoded_of(colour, blend_space):
+    alpha = colour[3]
+    visible = alpha > 0
+    straight = np.clip(colour[:3] / np.where(visible, alpha, np.float32(1)), 0, 1).astype(np.float32)
+    return (linear_to_srgb(straight.T).T if blend_space == "linear" else straight).astype(np.float32)
+
+
+def key_values(encoded, key):
+    """The table keys of encoded colour planes ``(3, N)``: shape (3, N), one row per table
+    column (luma and the scale keys repeat one value)."""
+    if key in SCALE_KEYS:
+        values = srgb_to_linear(encoded.T).T.astype(np.float32) if key == "luminance_scale" else encoded
+        luma = values[0] * _LUMA[0] + values[1] * _LUMA[1] + values[2] * _LUMA[2]
+        return np.broadcast_to(luma, encoded.shape)
+    if key == "luma":
+        return np.broadcast_to(encoded[0] * _LUMA[0] + encoded[1] * _LUMA[1] + encoded[2] * _LUMA[2],
+                               encoded.shape)
+    return encoded
+
+
+def filtered_colour(colour, prior, blend_space, low_end=None, high_end=None):
     """``f`` of working-space colours, by the prior's table.
 
     Parameters
@@ -223,7 +257,12 @@ def filtered_colour(colour, prior, blend_space):
     -------
     ndarray of float32, shape (4, N)
         Premultiplied working-space ``f(colour)``, with the colour's own alpha.
+    low_end, high_end : ndarray of bool, shape (3, N), optional
+        Where to clamp the keys to the observed range from below / above (per table column).
     """
+    if low_end is not None:
+        low, high = prior.key_range()
+        return _filtered_clamped(colour, prior, blend_space, low_end, high_end, low, high)
     alpha = colour[3]
     visible = alpha > 0
     straight = np.clip(colour[:3] / np.where(visible, alpha, np.float32(1)), 0, 1).astype(np.float32)
@@ -246,6 +285,81 @@ def filtered_colour(colour, prior, blend_space):
         out[c] = below + (above - below) * fraction[c]
     decoded = srgb_to_linear(np.clip(out, 0, 1).T).T if blend_space == "linear" else out
     return np.concatenate([decoded * alpha, alpha[None]], axis=0).astype(np.float32)
+
+
+def _filtered_clamped(colour, prior, blend_space, low_end, high_end, low, high):
+    """``filtered_colour`` with keys clamped to ``[low, high]`` where `low_end` / `high_end`."""
+    alpha = colour[3]
+    encoded = _encoded_of(colour, blend_space)
+    keys = key_values(encoded, prior.key)
+    keys = np.where(low_end, np.maximum(keys, low[:, None]), keys)
+    keys = np.where(high_end, np.minimum(keys, high[:, None]), keys).astype(np.float32)
+    if prior.key in SCALE_KEYS:
+        values = srgb_to_linear(encoded.T).T.astype(np.float32) if prior.key == "luminance_scale" else encoded
+        luma = values[0] * _LUMA[0] + values[1] * _LUMA[1] + values[2] * _LUMA[2]
+        mapped = _table_at(prior.table[:, 0], keys[0]).astype(np.float32)
+        lit = luma > np.float32(_SCALE_BLACK)
+        ratio = mapped / np.where(lit, luma, np.float32(1))
+        out = np.clip(np.where(lit, values * ratio, mapped), 0, 1).astype(np.float32)
+        out = (linear_to_srgb(out.T).T if prior.key == "luminance_scale" else out).astype(np.float32)
+    else:
+        out = np.stack([_table_at(prior.table[:, c], keys[c]) for c in range(3)]).astype(np.float32)
+    decoded = srgb_to_linear(np.clip(out, 0, 1).T).T if blend_space == "linear" else out
+    return np.concatenate([decoded * alpha, alpha[None]], axis=0).astype(np.float32)
+
+
+#: An extreme whose key lies within this of an end of O's key range is read with the
+#: table clamped there (see :class:`PureColourPrior`).
+RANGE_TOLERANCE = 0.05
+# Power-law extrapolation of a table end: the second point lies this far inside the range.
+_EXTRAPOLATION_STEP = 0.05
+
+
+def extrapolate_table(table, filled):
+    """Extend a table beyond its filled bins by a power law through the end.
+
+    Below the first filled bin ``x0``: ``f(x) = f(x0) (x / x0)^p``, with p from ``x0`` and the
+    filled bin nearest ``x0 + 0.05``, where the table rises there from above zero (a levels
+    or gamma curve meets black at black); above the last: the same in ``1 - x`` and
+    ``1 - f``. Elsewhere (flat or falling ends) the table stays flat, as ``np.interp`` left it.
+
+    Parameters
+    ----------
+    table : ndarray of float32, shape (256, 3)
+    filled : ndarray of bool, shape (256, 3)
+        Bins that held pixels, per column.
+
+    Returns
+    -------
+    table : ndarray of float32, shape (256, 3)
+    low, high : ndarray of float32, shape (3,)
+        Bin centres of the first and last filled bins.
+    """
+    out = table.astype(np.float64).copy()
+    centres = (np.arange(256) + 0.5) / 256
+    low, high = np.zeros(3, np.float32), np.ones(3, np.float32)
+    for c in range(3):
+        where = np.nonzero(filled[:, c])[0]
+        if len(where) < 2:
+            continue
+        first, last = where[0], where[-1]
+        low[c], high[c] = centres[first], centres[last]
+        for end in (first, last):
+            sign = 1 if end == first else -1
+            x0 = centres[end] if sign > 0 else 1 - centres[end]
+            f0 = out[end, c] if sign > 0 else 1 - out[end, c]
+            target = centres[end] + sign * _EXTRAPOLATION_STEP
+            other = where[np.argmin(np.abs(centres[where] - target))]
+            x1 = centres[other] if sign > 0 else 1 - centres[other]
+            f1 = out[other, c] if sign > 0 else 1 - out[other, c]
+            if not (x1 > x0 * 1.05 and f0 > 1e-3 and f1 > f0 * 1.001):
+                continue
+            power = min(np.log(f1 / f0) / np.log(x1 / x0), 8.0)
+            span = np.arange(0, end) if sign > 0 else np.arange(end + 1, 256)
+            x = centres[span] if sign > 0 else 1 - centres[span]
+            f = f0 * (x / x0) ** power
+            out[span, c] = f if sign > 0 else 1 - f
+    return out.astype(np.float32), low, high
 
 
 def extend_extreme(far, near, neighbours, filtered_far, on_border, palette, prior, blend_space):
@@ -310,5 +424,15 @@ def extend_extreme(far, near, neighbours, filtered_far, on_border, palette, prio
         reach = np.minimum(reach, np.minimum(up, down))
     reach = np.maximum(reach, np.float32(1)).astype(np.float32)
     colour = np.where(candidate, near + reach * span, far).astype(np.float32)
-    filtered = filtered_colour(colour, prior, blend_space)
+    if prior.key_low is None:
+        filtered = filtered_colour(colour, prior, blend_space)
+    else:
+        # At an end of O's range the extreme is read with the table clamped there: a dark
+        # paper between thin white lines is O's darkest colour, not a blend of unseen ink.
+        low, high = prior.key_range()
+        far_keys = key_values(_encoded_of(far, blend_space), prior.key)
+        tolerance = np.float32(RANGE_TOLERANCE)
+        low_end = far_keys <= low[:, None] + tolerance
+        high_end = far_keys >= high[:, None] - tolerance
+        filtered = filtered_colour(colour, prior, blend_space, low_end, high_end)
     return candidate, colour, filtered

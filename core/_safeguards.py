@@ -33,7 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._groundtruth import box_downsample
-from ._pure_colours import EXTENSION_KEYS, SCALE_KEYS, PureColourPrior, is_monotone, palette_of, scale_transfer
+from ._pure_colours import (EXTENSION_KEYS, SCALE_KEYS, PureColourPrior, extrapolate_table, is_monotone, key_values,
+                            palette_of, scale_transfer)
 from ._reference import fit_blend_model, from_working_space, jacobi_step, to_working_space
 
 __all__ = ["SafePlan", "plan_recovery", "choose_blend_space", "fit_lowpass", "fit_pointwise"]
@@ -363,6 +364,15 @@ def _scale_tables(original, filtered, key):
                  for at_mean_key in (False, True))
 
 
+def _filled_bins(original, key):
+    """Which of a table's bins O's pixels fill, per column: ndarray of bool, shape (256, 3)."""
+    keys = key_values(np.ascontiguousarray(original.reshape(-1, 3).T, dtype=np.float32), key)
+    filled = np.zeros((_LUT_BINS, 3), bool)
+    for c in range(3):
+        filled[:, c] = np.bincount(_bins(keys[c]), minlength=_LUT_BINS) > 0
+    return filled
+
+
 def _recover_at(work_o, work_f, filtered_rgba, space, strength, sigma_d, sigma_e, iterations):
     model = fit_blend_model(work_o, work_f, sigma_d, sigma_e, strength=strength)
     recovered = work_f
@@ -434,14 +444,16 @@ def plan_recovery(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=0
         # F's damage; measured, it chose strengths of 0.25-0.5 that lost 3-8 dB of the
         # paper's gain on synthetic scenes. Full strength is the measured best.
         # With a monotone per-channel or luma table, thin features get their pure colours
-        # (_pure_colours.py): quick suite 0.600 -> 0.712 (linear), 0.628 -> 0.686 (sRGB).
+        # (_pure_colours.py): quick suite 0.600 -> 0.712 (linear), 0.628 -> 0.686 (sRGB); the
+        # table's ends extended by a power law (extrapolate_table): 0.774 / 0.734.
         # Keys often tie (a threshold of black/white text matches per channel and by luma);
         # the first that is also fit for the extension is used.
         prior = None
         for candidate in transfer.alternatives:
             if candidate.consistency >= _POINTWISE_SHARE and candidate.key in EXTENSION_KEYS \
                     and is_monotone(candidate.table):
-                prior = PureColourPrior(candidate.key, candidate.table.astype(np.float32), palette_of(o))
+                table, low, high = extrapolate_table(candidate.table, _filled_bins(o, candidate.key))
+                prior = PureColourPrior(candidate.key, table, palette_of(o), low, high)
                 break
         return SafePlan(space, 1.0, f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges "
                                     "match) on hard-edged content: full strength"

@@ -80,3 +80,17 @@ def test_tiled_maps_equal_untiled(backend):
                                   tile_size=2 * halo_for(0) + 3)
     for name in aarecovery.RecoveryMaps.NAMES:
         np.testing.assert_array_equal(getattr(tiled, name), getattr(whole, name))
+
+
+def test_table_ends_are_extrapolated_by_a_power_law():
+    # A gamma curve seen only on [0.1, 1] reaches black at black (gamma on lines/sRGB: the
+    # 0.7 px black lines never show a black pixel in O); a threshold's flat end stays flat.
+    from aarecovery._pure_colours import extrapolate_table
+    centres = (np.arange(256) + 0.5) / 256
+    filled = np.repeat((centres >= 0.1)[:, None], 3, axis=1)
+    gamma = np.repeat(np.where(centres >= 0.1, centres, 0.1)[:, None] ** 0.5, 3, axis=1).astype(np.float32)
+    table, low, high = extrapolate_table(gamma, filled)
+    assert table[0, 0] < 0.08 and abs(low[0] - centres[filled[:, 0]][0]) < 1e-6 and high[0] == centres[-1]
+    np.testing.assert_allclose(table[filled[:, 0]], gamma[filled[:, 0]])
+    step = np.repeat(np.where(centres >= 0.5, 1.0, 0.0)[:, None], 3, axis=1).astype(np.float32)
+    np.testing.assert_array_equal(extrapolate_table(step, filled)[0], step)

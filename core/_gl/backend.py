@@ -343,8 +343,11 @@ class GLBackend:
             palette = np.zeros((32, 3), np.float32)
             colours = prior.palette_in(self._blend_space)
             palette[:len(colours)] = colours
+            low, high = prior.key_range()
             uniforms.update(table_key=prior.key_code, palette_size=len(colours),
-                            palette=[tuple(map(float, colour)) for colour in palette])
+                            palette=[tuple(map(float, colour)) for colour in palette],
+                            key_low=tuple(map(float, low)), key_high=tuple(map(float, high)),
+                            clamp_ends=int(prior.key_low is not None))
             sources["transfer_table"] = t["transfer_table"]
             jacobi_inputs = {"fixed_a_map": t["fixed_a"], "fixed_b_map": t["fixed_b"]}
         with self._passes():

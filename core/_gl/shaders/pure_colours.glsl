@@ -8,11 +8,15 @@ uniform int table_key;             // 0: each channel indexes its own column, 1:
                                    // colour scaled with it (scale_transfer)
 uniform vec3 palette[32];          // O's flat colours, opaque, in the working space
 uniform int palette_size;
+uniform vec3 key_low;              // O's key range (bin centres of the table's first and last
+uniform vec3 key_high;             // filled bins, per column); beyond it the table is extrapolated
+uniform int clamp_ends;            // 1: an extreme at an end of the range reads the table clamped
 
 const float PALETTE_TOLERANCE = 0.03;
 const float LINE_TOLERANCE = 0.05;
 const float RIDGE_MARGIN = 0.1;
 const float EXPLAIN_TOLERANCE = 0.02;
+const float RANGE_TOLERANCE = 0.05;
 const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
 
 float table_at(float key, int channel) {
@@ -26,29 +30,40 @@ float table_at(float key, int channel) {
     return below + (above - below) * fraction;
 }
 
-// f of a premultiplied working-space colour, by the table.
-vec4 filtered_colour(vec4 colour) {
+vec3 encoded_of(vec4 colour) {
     float coverage = colour.a;
     vec3 straight = clamp(colour.rgb / (coverage > 0.0 ? coverage : 1.0), 0.0, 1.0);
 #if WORK_IS_LINEAR
-    vec3 encoded = linear_to_srgb(straight);
+    return linear_to_srgb(straight);
 #else
-    vec3 encoded = straight;
+    return straight;
 #endif
+}
+
+// The table keys of an encoded colour, one per table column (key_values).
+vec3 key_values(vec3 encoded) {
+    if (table_key == 0) return encoded;
+    vec3 values = table_key == 3 ? srgb_to_linear(encoded) : encoded;
+    return vec3(values.r * LUMA.r + values.g * LUMA.g + values.b * LUMA.b);
+}
+
+// f of a premultiplied working-space colour, by the table, its keys clamped from below /
+// above to O's key range where low_end / high_end.
+vec4 filtered_colour_clamped(vec4 colour, bvec3 low_end, bvec3 high_end) {
+    float coverage = colour.a;
+    vec3 encoded = encoded_of(colour);
+    vec3 keys = key_values(encoded);
+    keys = mix(keys, max(keys, key_low), vec3(low_end));
+    keys = mix(keys, min(keys, key_high), vec3(high_end));
     vec3 out_colour;
     if (table_key >= 2) {
         vec3 values = table_key == 3 ? srgb_to_linear(encoded) : encoded;
         float luma = values.r * LUMA.r + values.g * LUMA.g + values.b * LUMA.b;
-        float mapped = table_at(luma, 0);
+        float mapped = table_at(keys.r, 0);
         vec3 scaled = luma > 1e-6 ? values * (mapped / luma) : vec3(mapped);
         scaled = clamp(scaled, 0.0, 1.0);
         out_colour = table_key == 3 ? linear_to_srgb(scaled) : scaled;
     } else {
-        vec3 keys = encoded;
-        if (table_key == 1) {
-            float luma = encoded.r * LUMA.r + encoded.g * LUMA.g + encoded.b * LUMA.b;
-            keys = vec3(luma);
-        }
         out_colour = vec3(table_at(keys.r, 0), table_at(keys.g, 1), table_at(keys.b, 2));
     }
 #if WORK_IS_LINEAR
@@ -57,6 +72,11 @@ vec4 filtered_colour(vec4 colour) {
     vec3 decoded = out_colour;
 #endif
     return vec4(decoded * coverage, coverage);
+}
+
+// f of a premultiplied working-space colour, by the table.
+vec4 filtered_colour(vec4 colour) {
+    return filtered_colour_clamped(colour, bvec3(false), bvec3(false));
 }
 
 // Both pixels lie on the colour line and are less extreme than `limit` along it.
@@ -114,6 +134,14 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
     reach = max(reach, 1.0);
     result.extended = true;
     result.colour = near + reach * span;
-    result.filtered = filtered_colour(result.colour);
+    // At an end of O's key range the extreme is read with the table clamped there (a dark
+    // paper, not unseen ink: _pure_colours.extend_extreme).
+    bvec3 low_end = bvec3(false), high_end = bvec3(false);
+    if (clamp_ends != 0) {
+        vec3 far_keys = key_values(encoded_of(far));
+        low_end = lessThanEqual(far_keys, key_low + RANGE_TOLERANCE);
+        high_end = greaterThanEqual(far_keys, key_high - RANGE_TOLERANCE);
+    }
+    result.filtered = filtered_colour_clamped(result.colour, low_end, high_end);
     return result;
 }
