@@ -350,18 +350,18 @@ def colour_to_grey(image, chroma_weight=0.6, bright_hue=30.0):
 # ----------------------------------------------------------------------------- neighbourhood
 
 
-def _gaussian_kernel(sigma):
-    radius = max(1, int(np.ceil(3 * sigma)))
+def _gaussian_kernel(sigma, truncate=3.0):
+    radius = max(1, int(np.ceil(truncate * sigma)))
     x = np.arange(-radius, radius + 1, dtype=np.float64)
     kernel = np.exp(-0.5 * (x / sigma) ** 2)
     return (kernel / kernel.sum()).astype(np.float32)
 
 
-def _convolve_axis(values, kernel, axis):
+def _convolve_axis(values, kernel, axis, mode="edge"):
     radius = len(kernel) // 2
     pad = [(0, 0)] * values.ndim
     pad[axis] = (radius, radius)
-    padded = np.pad(values, pad, mode="edge")
+    padded = np.pad(values, pad, mode=mode)
     size = values.shape[axis]
     out = np.zeros_like(values)
     for i, weight in enumerate(kernel):
