@@ -143,7 +143,8 @@ def test_borrowed_context_state_is_restored():
 
 @pytest.mark.parametrize("scene, filter_name, space", [("text", "threshold", "linear"), ("lines", "gamma", "srgb"),
                                                        ("lines", "gradientmap", "linear"),
-                                                       ("lines", "tonemap", "srgb"), ("lines", "equalize", "srgb")])
+                                                       ("lines", "tonemap", "srgb"), ("lines", "equalize", "srgb"),
+                                                       ("lines", "posterize", "srgb")])
 def test_pure_colours_agree(gl_engine, scene, filter_name, space):
     # The safe default's pure-colour extension (fit_pure_colour_model, jacobi_step with fixed
     # colours) on thin features, 8-bit: the final R within 1/255, and the extension in use.

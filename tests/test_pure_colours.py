@@ -94,3 +94,19 @@ def test_table_ends_are_extrapolated_by_a_power_law():
     np.testing.assert_allclose(table[filled[:, 0]], gamma[filled[:, 0]])
     step = np.repeat(np.where(centres >= 0.5, 1.0, 0.0)[:, None], 3, axis=1).astype(np.float32)
     np.testing.assert_array_equal(extrapolate_table(step, filled)[0], step)
+
+
+@pytest.mark.parametrize("filter_name", ["gamma", "equalize", "tonemap"])
+def test_darkest_colour_between_thin_lines_is_pure(filter_name):
+    # The dark paper between 0.5 px white lines (lines scene, lower right panel) is O's darkest
+    # colour and no flat colour (the gaps are 1.1 px): a ridge, but not a partial colour. It
+    # used to be extended to black, so that the whole paper was recovered as a blend of
+    # f(black) and f(white) (equalize: 0.145 where F and the reference are 0.05).
+    case = make_case(_scenes.render("lines", 80, 4), filter_name, 4, "srgb")
+    o, f = case.original, case.filtered
+    recovered = aarecovery.recover(o, f, backend="numpy")
+    height, width = o.shape[:2]
+    panel = (slice(height // 2 + 2, height - 2), slice(width // 2 + 2, width - 2))
+    paper = np.abs(o[panel] - 0.1).max(axis=-1) < 0.5 / 255
+    assert paper.sum() > 50
+    assert np.abs(recovered[panel][paper] - f[panel][paper]).max() < 2 / 255

@@ -17,6 +17,7 @@ const float LINE_TOLERANCE = 0.05;
 const float RIDGE_MARGIN = 0.1;
 const float EXPLAIN_TOLERANCE = 0.02;
 const float RANGE_TOLERANCE = 0.05;
+const float END_TOLERANCE = 1.0 / 255.0;
 const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
 
 float table_at(float key, int channel) {
@@ -122,6 +123,23 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
               || lower_pair(q + OFFSETS[5], q + OFFSETS[8], near, direction, t_far - margin, size)
               || lower_pair(q + OFFSETS[6], q + OFFSETS[7], near, direction, t_far - margin, size);
     if (!ridge) return result;
+    // An extreme that is O's darkest or brightest colour is pure (a paper between thin lines),
+    // unless the other extreme is the opposite end or a flat colour (_pure_colours.extend_extreme).
+    if (clamp_ends != 0) {
+        vec3 far_keys = key_values(encoded_of(far));
+        vec3 near_keys = key_values(encoded_of(near));
+        bool far_low = all(lessThanEqual(far_keys, key_low + END_TOLERANCE));
+        bool far_high = all(greaterThanEqual(far_keys, key_high - END_TOLERANCE));
+        bool near_low = all(lessThanEqual(near_keys, key_low + END_TOLERANCE));
+        bool near_high = all(greaterThanEqual(near_keys, key_high - END_TOLERANCE));
+        bool near_pure = false;
+        for (int i = 0; i < palette_size; ++i) {
+            vec3 miss = near.rgb - palette[i] * near.a;
+            near_pure = near_pure || (miss.r * miss.r + miss.g * miss.g + miss.b * miss.b
+                                      < PALETTE_TOLERANCE * PALETTE_TOLERANCE);
+        }
+        if (((far_low && !near_high) || (far_high && !near_low)) && !near_pure) return result;
+    }
     // Largest s >= 1 with near + s span inside the premultiplied cube 0 <= rgb <= alpha <= 1.
     float reach = 1e6;
     for (int c = 0; c < 4; ++c) {
