@@ -183,6 +183,24 @@ def _sobel_magnitude(v):
     return np.sqrt(_dot(gx, gx) + _dot(gy, gy))
 
 
+def sobel_gradients(image):
+    """Sobel derivatives divided by 8 (a unit ramp gives 1), borders replicated.
+
+    Parameters
+    ----------
+    image : ndarray of float, shape (H, W, C)
+
+    Returns
+    -------
+    gx, gy : ndarray, shape (H, W, C)
+        Per channel, in the image's dtype.
+    """
+    planes = _neighbours(np.moveaxis(image, -1, 0))
+    gx = ((planes[6] - planes[5]) + 2 * (planes[3] - planes[2]) + (planes[8] - planes[7])) / 8
+    gy = ((planes[7] - planes[5]) + 2 * (planes[4] - planes[1]) + (planes[8] - planes[6])) / 8
+    return np.moveaxis(gx, 0, -1), np.moveaxis(gy, 0, -1)
+
+
 def edge_strength(original, filtered):
     """Edge strength ``e_p``: the product of the Sobel magnitudes of O and F.
 

@@ -35,7 +35,7 @@ import numpy as np
 from ._groundtruth import box_downsample
 from ._pure_colours import (EXTENSION_KEYS, SCALE_KEYS, PureColourPrior, extrapolate_table, is_monotone, key_values,
                             palette_of, scale_transfer)
-from ._reference import fit_blend_model, from_working_space, jacobi_step, to_working_space
+from ._reference import fit_blend_model, from_working_space, jacobi_step, sobel_gradients, to_working_space
 
 __all__ = ["SafePlan", "plan_recovery", "choose_blend_space", "fit_lowpass", "fit_pointwise"]
 
@@ -114,11 +114,7 @@ def _analysis_crop(image):
 
 
 def _sobel(image):
-    padded = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
-    h, w = image.shape[:2]
-    at = lambda dy, dx: padded[1 + dy:1 + dy + h, 1 + dx:1 + dx + w]
-    gx = (at(-1, 1) + 2 * at(0, 1) + at(1, 1) - at(-1, -1) - 2 * at(0, -1) - at(1, -1)) / 8
-    gy = (at(1, -1) + 2 * at(1, 0) + at(1, 1) - at(-1, -1) - 2 * at(-1, 0) - at(-1, 1)) / 8
+    gx, gy = sobel_gradients(image)
     return np.sqrt(np.sum(gx * gx + gy * gy, axis=-1))
 
 
