@@ -78,7 +78,7 @@ def register(subparsers):
                              "is always replaced)")
     parser.add_argument("--tile-size", type=int, metavar="N",
                         help="largest tile side in pixels; larger images are processed in overlapping "
-                             "tiles with the same result (default: the backend's limit)")
+                             "tiles with the same result (default: 2048 on GL, 512 on NumPy)")
     parser.set_defaults(run=run)
     return parser
 
