@@ -10,6 +10,7 @@ import os
 import shutil
 import sys
 import time
+import warnings
 from dataclasses import dataclass
 
 import glfw  # before imgui_bundle: see glfw_platform
@@ -87,7 +88,11 @@ class ViewerApp:
 
     def __init__(self, source=None, *, settings=None, size=(1280, 720), visible=True, vsync=True,
                  title="aarecovery view"):
-        if not glfw.init():
+        with warnings.catch_warnings():
+            # GLFW's own warning repeats the reason that the one-line error below gives.
+            warnings.simplefilter("ignore", glfw.GLFWError)
+            started = glfw.init()
+        if not started:
             raise WindowError(f"cannot start GLFW ({_glfw_error_text()}); "
                               "is there a display (DISPLAY or WAYLAND_DISPLAY)?")
         glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 3)
