@@ -251,7 +251,7 @@ def gimp_runs():
                 runs[mode] = {"exit": proc.returncode, "log": proc.stdout + proc.stderr,
                               "dir": run_dir, "cases": {c["name"]: c for c in chosen},
                               "results": {r["name"]: r for r in json.loads(results_file.read_text())}}
-            print(f"\nGIMP test timings (s): " +
+            print("\nGIMP test timings (s): " +
                   ", ".join(f"{k} {v:.1f}" for k, v in timings.items()), file=sys.stderr)
             yield runs
         finally:

@@ -4,8 +4,6 @@ Events go through the GLFW callbacks the app registered, the functions GLFW itse
 from glfw.poll_events(): from there on scripted input takes the path real input takes.
 """
 
-import os
-
 import numpy as np
 import pytest
 
