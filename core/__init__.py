@@ -7,16 +7,20 @@ filtered image F show the same blend with its own colours.
 Every function takes images as NumPy arrays ``(H, W)`` or ``(H, W, C)`` with C in 1..4
 (grey, grey+alpha, RGB, RGBA), uint8, uint16 or float in [0, 1], sRGB-encoded unless
 declared linear, row 0 at the top, straight alpha.
-"""
 
-from . import filters
-from ._engine import BACKENDS, Engine, RecoveryMaps
-from ._errors import InputError
-from ._io import read_image, write_image
-from ._params import BLEND_SPACES, MODES
-from ._recover import recover
+The public API is what ``__all__`` lists; the subpackages are the implementation, laid out
+in ``docs/architecture.md``.
+"""
 
 __version__ = "0.1.0"
 
+from . import filters
+from .backends.base import RecoveryMaps
+from .engine import Engine
+from .errors import InputError
+from .io import read_image, write_image
+from .params import BACKENDS, BLEND_SPACES, MODES, PARAMETERS
+from .pipeline import recover
+
 __all__ = ["recover", "Engine", "RecoveryMaps", "InputError", "read_image", "write_image", "filters",
-           "BACKENDS", "MODES", "BLEND_SPACES", "__version__"]
+           "PARAMETERS", "BACKENDS", "MODES", "BLEND_SPACES", "__version__"]

@@ -31,7 +31,7 @@ def gl_unavailable_reason():
     """None when a standalone GL 3.3 context can be made here, else why not."""
     global _gl_problem
     if _gl_problem is None:
-        from aarecovery._gl.context import GLUnavailable, create_context
+        from aarecovery.backends.gl.context import GLUnavailable, create_context
         try:
             create_context().release()
             _gl_problem = ""

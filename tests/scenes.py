@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from aarecovery._colour import linear_to_srgb, srgb_to_linear
+from aarecovery.colour import linear_to_srgb, srgb_to_linear
 
 
 def box_downsample(image, factor):

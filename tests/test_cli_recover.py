@@ -238,7 +238,7 @@ def test_alpha_result_to_jpeg_is_refused_before_recovery(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("option, value, words", [
-    ("--sigma-e", "0", ("sigma_e", "above 0")),
+    ("--sigma-e", "0", ("sigma_e", "from 0.0001 to 1")),
     ("--sigma-d", "nan", ("sigma_d", "nan")),
     ("--iterations", "65", ("iterations", "65")),
     ("--tile-size", "5", ("--tile-size 5", "at least 9")),

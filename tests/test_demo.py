@@ -5,7 +5,7 @@ import os
 import numpy as np
 from PIL import Image
 
-from aarecovery._demo import DEMO_FILTERS, run_demo
+from aarecovery.lab.demo import DEMO_FILTERS, run_demo
 from aarecovery.cli import main
 
 

@@ -3,9 +3,10 @@
 import numpy as np
 import pytest
 
-from aarecovery import _eval
-from aarecovery._metrics import edge_band, error_reduction, psnr, ssim
-from aarecovery._peers import PEERS
+from aarecovery.lab import evaluate as _eval
+from aarecovery.lab import report as _report
+from aarecovery.lab.metrics import edge_band, error_reduction, psnr, ssim
+from aarecovery.lab.peers import PEERS
 
 
 @pytest.fixture(scope="module")
@@ -53,7 +54,7 @@ def test_missing_peers_are_reported_loudly():
                                 psnr={"F": 10, "R": 12}, ssim={"F": 0.5, "R": 0.6},
                                 psnr_band={"F": 10, "R": 12}, ssim_band={"F": 0.5, "R": 0.6},
                                 reduction={"R": 0.3})]
-    table = _eval.format_table(results, missing=PEERS)
+    table = _report.format_table(results, missing=PEERS)
     assert table.count("NOT installed") == len(PEERS)
     assert "gegl" in table and "gmic" in table
 
@@ -101,9 +102,9 @@ def test_mean_error_reduction_reaches_the_target(quick):
 def test_table_and_report_are_written(tmp_path):
     suite = _eval.Suite(("shapes",), ("threshold", "blur"), 32)
     results, missing = _eval.run_suite(suite, backend="numpy", peers=False, keep_images=True)
-    table = _eval.format_table(results, missing)
+    table = _report.format_table(results, missing)
     assert "== threshold" in table and "== blur" in table and "worst edge-band loss" in table
-    path = _eval.write_report(results, str(tmp_path), missing)
+    path = _report.write_report(results, str(tmp_path), missing)
     text = open(path, encoding="utf-8").read()
     assert "threshold-crop.png" in text
     from PIL import Image

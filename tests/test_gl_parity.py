@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import aarecovery
-from aarecovery import _reference
-from aarecovery._contract import layout_of, to_rgba_float
+from aarecovery import spec
+from aarecovery.contract import layout_of, to_rgba_float
 from scenes import luminance, shapes, to_uint8
 
 pytestmark = pytest.mark.gl
@@ -41,11 +41,11 @@ IDS = [name for name, *_ in PAIRS]
 
 
 def _numpy_model(original, filtered, blend_space="linear", linear=False):
-    o = _reference.to_working_space(to_rgba_float(original, layout_of(original, "o"), "o"),
+    o = spec.to_working_space(to_rgba_float(original, layout_of(original, "o"), "o"),
                                     linear_input=linear, blend_space=blend_space)
-    f = _reference.to_working_space(to_rgba_float(filtered, layout_of(filtered, "f"), "f"),
+    f = spec.to_working_space(to_rgba_float(filtered, layout_of(filtered, "f"), "f"),
                                     linear_input=linear, blend_space=blend_space)
-    return o, f, _reference.fit_blend_model(o, f, 0.1, 0.01)
+    return o, f, spec.fit_blend_model(o, f, 0.1, 0.01)
 
 
 @pytest.fixture(scope="module")
@@ -148,8 +148,8 @@ def test_borrowed_context_state_is_restored():
 def test_pure_colours_agree(gl_engine, scene, filter_name, space):
     # The safe default's pure-colour extension (fit_pure_colour_model, jacobi_step with fixed
     # colours) on thin features, 8-bit: the final R within 1/255, and the extension in use.
-    from aarecovery import _scenes
-    from aarecovery._groundtruth import make_case
+    from aarecovery.lab import scenes as _scenes
+    from aarecovery.lab.groundtruth import make_case
     case = make_case(_scenes.render(scene, 48, 4), filter_name, 4, space)
     original = np.rint(case.original * 255).astype(np.uint8)
     filtered = np.rint(case.filtered * 255).astype(np.uint8)
@@ -171,8 +171,8 @@ def test_pure_colours_agree(gl_engine, scene, filter_name, space):
 
 def _sparse_pair():
     """A few features in a large flat image: most blocks are skipped."""
-    from aarecovery._groundtruth import make_case
-    from aarecovery._scenes import render
+    from aarecovery.lab.groundtruth import make_case
+    from aarecovery.lab.scenes import render
     case = make_case(render("text", 48, 4), "threshold", 4, "linear")
     original = np.full((160, 176, 3), 255, np.uint8)
     filtered = np.full((160, 176, 3), 255, np.uint8)
@@ -202,7 +202,7 @@ def test_block_passes_match_whole_image_passes(gl_engine, mode):
     # The fit and inner Jacobi passes draw only blocks where the edge strength can be non-zero
     # (F not flat; O not flat with pure colours). A few features in a large flat image, so that
     # most blocks are skipped, must give the NumPy result everywhere.
-    from aarecovery._gl.backend import BLOCK_SIDE
+    from aarecovery.backends.gl.blocks import BLOCK_SIDE
     original, filtered = _sparse_pair()
     actual = aarecovery.recover(original, filtered, engine=gl_engine, mode=mode)
     counts = {name: count for name, (count, _) in gl_engine._impl._blocks.items()}

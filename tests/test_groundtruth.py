@@ -3,9 +3,10 @@
 import numpy as np
 import pytest
 
-from aarecovery import _scenes, filters
-from aarecovery._groundtruth import box_downsample, make_case
-from aarecovery._colour import linear_to_srgb
+from aarecovery import filters
+from aarecovery.lab import scenes as _scenes
+from aarecovery.lab.groundtruth import box_downsample, make_case
+from aarecovery.colour import linear_to_srgb
 
 
 def test_box_downsample_averages_in_the_requested_space():

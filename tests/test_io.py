@@ -14,7 +14,7 @@ from PIL import Image
 
 import aarecovery
 from aarecovery import InputError, read_image, write_image
-from aarecovery import _io
+from aarecovery.io import write as _io
 
 LAYOUTS = {"grey": (5, 7), "grey+alpha": (5, 7, 2), "rgb": (5, 7, 3), "rgba": (5, 7, 4)}
 

@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 
 import aarecovery
-from aarecovery import _scenes
-from aarecovery._groundtruth import make_case
-from aarecovery._metrics import edge_band, error_reduction
-from aarecovery._pure_colours import palette_of
-from aarecovery._recover import halo_for
-from aarecovery._reference import fit_blend_model, to_working_space
-from aarecovery._safeguards import plan_recovery
+from aarecovery.lab import scenes as _scenes
+from aarecovery.lab.groundtruth import make_case
+from aarecovery.lab.metrics import edge_band, error_reduction
+from aarecovery.plan.pure_colours import palette_of
+from aarecovery.tiling import halo_for
+from aarecovery.spec import fit_blend_model, to_working_space
+from aarecovery.plan import analyse
 
 
 def rgba(image):
@@ -33,7 +33,7 @@ def test_palette_holds_flat_colours_only():
 
 def test_thin_strokes_erased_by_threshold_are_restored():
     case = thin_line_case()
-    plan = plan_recovery(rgba(case.original), rgba(case.filtered))
+    plan = analyse(rgba(case.original), rgba(case.filtered))
     assert plan.pure_colours is not None and plan.pure_colours.key == "luma"
     band = edge_band(case.original, case.filtered, case.reference)
     safe = aarecovery.recover(case.original, case.filtered, backend="numpy")
@@ -85,7 +85,7 @@ def test_tiled_maps_equal_untiled(backend):
 def test_table_ends_are_extrapolated_by_a_power_law():
     # A gamma curve seen only on [0.1, 1] reaches black at black (gamma on lines/sRGB: the
     # 0.7 px black lines never show a black pixel in O); a threshold's flat end stays flat.
-    from aarecovery._pure_colours import extrapolate_table
+    from aarecovery.plan.pure_colours import extrapolate_table
     centres = (np.arange(256) + 0.5) / 256
     filled = np.repeat((centres >= 0.1)[:, None], 3, axis=1)
     gamma = np.repeat(np.where(centres >= 0.1, centres, 0.1)[:, None] ** 0.5, 3, axis=1).astype(np.float32)

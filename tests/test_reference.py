@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import aarecovery
-from aarecovery._colour import linear_to_srgb, srgb_to_linear
+from aarecovery.colour import linear_to_srgb, srgb_to_linear
 from scenes import box_downsample, luminance, shapes, to_uint8, two_colour_edge
 
 

@@ -4,10 +4,14 @@ import numpy as np
 import pytest
 
 import aarecovery
-from aarecovery import _scenes, filters
-from aarecovery._groundtruth import make_case
-from aarecovery._reference import fit_blend_model, to_working_space
-from aarecovery._safeguards import choose_blend_space, fit_lowpass, fit_pointwise, plan_recovery
+from aarecovery import filters
+from aarecovery.lab import scenes as _scenes
+from aarecovery.lab.groundtruth import make_case
+from aarecovery.spec import fit_blend_model, to_working_space
+from aarecovery.plan import analyse
+from aarecovery.plan.blend_space import choose_blend_space
+from aarecovery.plan.lowpass import fit_lowpass
+from aarecovery.plan.pointwise import fit_pointwise
 
 
 def rgba(image):
@@ -29,7 +33,7 @@ def test_blend_space_is_the_space_of_the_antialiasing(shapes, space):
 def test_blur_is_detected_and_left_alone(shapes):
     case = make_case(shapes, "blur", 4, "srgb")
     assert fit_lowpass(case.original, case.filtered)[0]
-    plan = plan_recovery(rgba(case.original), rgba(case.filtered))
+    plan = analyse(rgba(case.original), rgba(case.filtered))
     assert plan.strength == 0
     result = aarecovery.recover(case.original, case.filtered, backend="numpy")
     np.testing.assert_array_equal(result, case.filtered)
@@ -71,7 +75,7 @@ def test_engine_compute_takes_the_mode(shapes):
     assert engine.last_plan is not None and engine.last_plan.blend_space == "srgb"
     np.testing.assert_array_equal(safe, aarecovery.recover(case.original, case.filtered, backend="numpy"))
     paper = engine.recover(mode="paper")
-    assert engine.last_plan is None
+    assert engine.last_plan.mode == "paper" and engine.last_plan.strength == 1
     np.testing.assert_array_equal(paper, aarecovery.recover(case.original, case.filtered, backend="numpy",
                                                             mode="paper"))
     with pytest.raises(aarecovery.InputError, match="'fast'"):

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import aarecovery
-from aarecovery._recover import halo_for, tiles
+from aarecovery.tiling import halo_for, tiles
 from scenes import shapes
 
 

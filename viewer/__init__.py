@@ -4,6 +4,7 @@ A GLFW window whose OpenGL context the recovery engine borrows: the engine's tex
 drawn directly, with Dear ImGui (imgui-bundle) widgets on top. Modules, one idea each:
 
 ``view_state``     zoom, pan and split arithmetic (pure Python)
+``glsl``           the GLSL sources (package resources)
 ``image_view``     the shader that draws images, maps, heat-maps and the split view
 ``imgui_renderer`` Dear ImGui's draw data drawn with moderngl
 ``glfw_platform``  GLFW input events fed to ImGui

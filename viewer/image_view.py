@@ -9,7 +9,7 @@ from typing import NamedTuple, Optional
 
 import moderngl
 
-from .shaders import program as build_program
+from .glsl import program as build_program
 
 __all__ = ["ImageSource", "Layer", "ImageView", "KIND_COLOUR", "KIND_MAP", "KIND_DIFFERENCE"]
 

@@ -10,7 +10,7 @@ import moderngl
 import numpy as np
 from imgui_bundle import imgui
 
-from .shaders import program
+from .glsl import program
 
 __all__ = ["ImGuiRenderer"]
 

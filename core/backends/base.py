@@ -1,0 +1,122 @@
+"""What every backend is given and gives back: the Plan, the maps, and the Backend protocol.
+
+These types live below the engine and the plan layer, so that both can use them and no
+import runs back up: the plan layer makes a :class:`Plan`, the engine hands it to a
+:class:`Backend`, and the backend returns pixels and :class:`RecoveryMaps`.
+"""
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+__all__ = ["Plan", "RecoveryMaps", "Capabilities", "Backend"]
+
+
+@dataclass(frozen=True)
+class Plan:
+    """How one image pair is recovered: the parameters and every per-image decision.
+
+    Made once per pair by ``aarecovery.plan.make_plan`` (before any tiling, so that tiles
+    share it) and taken as it is by the engine and every backend.
+
+    Attributes
+    ----------
+    sigma_d, sigma_e : float
+    iterations : int
+        The recovery parameters (``aarecovery.params``).
+    blend_space : {"linear", "srgb"}
+        Where the model is fitted and the blend happens.
+    strength : float
+        Multiplies the confidence ``beta``, in [0, 1]; 0 returns F unchanged, 1 is the paper.
+    pure_colours : PureColourPrior or None
+        The safe default's pure colours of thin features (``aarecovery.spec.pure_colours``);
+        None runs the paper's passes.
+    mode : {"safe", "paper"}
+    reason : str
+        One line saying why, for messages and the evaluation report.
+    """
+
+    sigma_d: float
+    sigma_e: float
+    iterations: int
+    blend_space: str = "linear"
+    strength: float = 1.0
+    pure_colours: object = None
+    mode: str = "paper"
+    reason: str = "the published method"
+
+    @property
+    def keeps_filtered(self):
+        """bool: the plan returns F unchanged (strength 0)."""
+        return self.strength == 0
+
+
+@dataclass
+class RecoveryMaps:
+    """Per-pixel intermediate maps of the last recovery, for viewers and debugging.
+
+    Attributes
+    ----------
+    alpha : ndarray of float32, shape (H, W)
+        Coverage of the first extreme colour.
+    beta : ndarray of float32, shape (H, W)
+        Confidence in [0, 1]: 0 keeps F, 1 imposes O's blend.
+    edge_strength : ndarray of float32, shape (H, W)
+        Product of the Sobel magnitudes of O and F.
+    residual : ndarray of float32, shape (H, W)
+        Distance of O's colour from its two-colour blend.
+    """
+
+    alpha: np.ndarray
+    beta: np.ndarray
+    edge_strength: np.ndarray
+    residual: np.ndarray
+
+    NAMES = ("alpha", "beta", "edge_strength", "residual")
+
+
+@dataclass(frozen=True)
+class Capabilities:
+    """What a backend can take.
+
+    Attributes
+    ----------
+    max_tile : int
+        The largest tile side it can hold (a texture limit for GL).
+    default_tile : int
+        The tile side it runs best at (measured; see ``docs/performance.md``).
+    """
+
+    max_tile: int
+    default_tile: int
+
+
+class Backend(Protocol):
+    """A place where the passes run: NumPy (the specification) or OpenGL.
+
+    The engine calls :meth:`load` once per image pair (or tile), then :meth:`run` once per
+    plan, then reads back. Images arrive as the caller gave them (any layout and dtype the
+    contract accepts, described by their ``Layout``); results go back as straight RGBA.
+    """
+
+    name: str
+    capabilities: Capabilities
+
+    def load(self, original, o_layout, filtered, f_layout, linear_input, blend_space):
+        """Take a checked pair and move it into the working space of `blend_space`."""
+
+    def run(self, plan, maps):
+        """Run the passes of `plan` on the loaded pair; keep the maps when `maps`."""
+
+    def finish(self):
+        """Block until the last run is complete."""
+
+    def read_result(self):
+        """The last result as ``(H, W, 4)`` straight RGBA: float32, or F's integer dtype."""
+
+    def read_maps(self):
+        """The maps of the last run with ``maps=True``, as :class:`RecoveryMaps`."""
+
+    def release(self):
+        """Free what the backend holds; it cannot be used afterwards."""

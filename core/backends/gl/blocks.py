@@ -1,0 +1,64 @@
+"""Which 16 x 16 blocks of pixels the passes must draw: those whose surroundings are not flat.
+
+Where O or F is flat around a pixel, its edge strength is exactly 0, beta is 0 and R = F;
+llvmpipe shades every fragment a triangle covers (both sides of a branch), so skipping must
+happen before the fragment shader, by drawing only the active blocks (``blocks.vert``).
+"""
+
+import numpy as np
+
+__all__ = ["BLOCK_SIDE", "active_blocks"]
+
+BLOCK_SIDE = 16
+
+
+def active_blocks(pixels, side=BLOCK_SIDE, margin=2):
+    """Blocks of `side` x `side` pixels whose surroundings are not flat.
+
+    A block is active when a pixel that differs from a neighbour lies in it or within
+    `margin` pixels of it. With a margin of 2, every pixel whose 3x3 window is not flat
+    (margin 1) and every neighbour such a pixel gathers in a Jacobi step (1 more) lies in an
+    active block, so the block passes write every value any pass reads, and the rest of the
+    image needs only the unfitted model.
+
+    Parameters
+    ----------
+    pixels : ndarray, shape (H, W, C), C-contiguous
+        An image as uploaded (any dtype): equal values here are equal in the working space.
+    side, margin : int
+
+    Returns
+    -------
+    ndarray of int32, shape (N, 2)
+        ``(column, row)`` block indices, row-major.
+    """
+    height, width, channels = pixels.shape
+    # Rows of interleaved values, compared C values apart: contiguous work, no per-channel
+    # strided views (3x faster at 4096 x 4096). A pixel differs where any of its values does,
+    # so blocks and margins are simply C times wider in values.
+    values = pixels.reshape(height, width * channels)
+    rows, columns = -(-height // side), -(-width // side)
+    touched = np.zeros((rows * side, columns * side * channels), bool)
+    across = values[:, channels:] != values[:, :-channels]
+    down = values[1:] != values[:-1]
+    touched[:height, channels:width * channels] |= across
+    touched[:height, :width * channels - channels] |= across
+    touched[1:height, :width * channels] |= down
+    touched[:height - 1, :width * channels] |= down
+    cells = touched.reshape(rows, side, columns, side * channels)
+    edge = margin * channels
+    active = cells.any(axis=(1, 3))
+    # A differing pixel within `margin` of a block's side also wakes the block beyond it.
+    active[:-1] |= cells[1:, :margin].any(axis=(1, 3))
+    active[1:] |= cells[:-1, -margin:].any(axis=(1, 3))
+    active[:, :-1] |= cells[:, :, 1:, :edge].any(axis=(1, 3))
+    active[:, 1:] |= cells[:, :, :-1, -edge:].any(axis=(1, 3))
+    corners = {(-1, -1): cells[:, :margin, :, :edge], (-1, 1): cells[:, :margin, :, -edge:],
+               (1, -1): cells[:, -margin:, :, :edge], (1, 1): cells[:, -margin:, :, -edge:]}
+    for (dy, dx), corner in corners.items():
+        # The corner of block (r, c) towards (r + dy, c + dx) wakes that diagonal neighbour.
+        hit = corner.any(axis=(1, 3))
+        active[max(0, dy):rows + min(0, dy), max(0, dx):columns + min(0, dx)] |= \
+            hit[max(0, -dy):rows - max(0, dy), max(0, -dx):columns - max(0, dx)]
+    found = np.argwhere(active)
+    return np.ascontiguousarray(found[:, ::-1], dtype=np.int32)

@@ -1,0 +1,65 @@
+"""Colour maths of the NumPy side, once: exact piecewise sRGB (IEC 61966-2-1) and luma weights.
+
+The GL backend has the same functions once, in ``backends/gl/shaders/colour.glsl``.
+"""
+
+import numpy as np
+
+__all__ = ["LUMA", "LUMA_WEIGHTS", "luma", "srgb_to_linear", "linear_to_srgb"]
+
+#: Rec. 709 / sRGB weights of R, G and B: luminance of linear light, and the "luma" of
+#: encoded values that image editors compute. Python floats, so that float32 and float64
+#: arrays of them each hold the nearest value of their own precision.
+LUMA = (0.2126, 0.7152, 0.0722)
+#: :data:`LUMA` as float32, for products with float32 colour.
+LUMA_WEIGHTS = np.array(LUMA, np.float32)
+
+
+def luma(colour):
+    """Weighted sum of the last axis (R, G, B) by :data:`LUMA_WEIGHTS`.
+
+    Parameters
+    ----------
+    colour : ndarray of float, shape (..., 3)
+
+    Returns
+    -------
+    ndarray, shape (...)
+    """
+    return colour @ LUMA_WEIGHTS
+
+
+def srgb_to_linear(encoded):
+    """Decode sRGB-encoded values to linear light.
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, any shape
+        Values in [0, 1].
+
+    Returns
+    -------
+    ndarray of float32, same shape
+    """
+    encoded = np.asarray(encoded, dtype=np.float32)
+    low = encoded * np.float32(1 / 12.92)
+    high = np.power((encoded + np.float32(0.055)) * np.float32(1 / 1.055), np.float32(2.4))
+    return np.where(encoded <= np.float32(0.04045), low, high).astype(np.float32, copy=False)
+
+
+def linear_to_srgb(linear):
+    """Encode linear-light values with the sRGB transfer function.
+
+    Parameters
+    ----------
+    linear : ndarray of float32, any shape
+        Values in [0, 1]; values outside are clipped first.
+
+    Returns
+    -------
+    ndarray of float32, same shape
+    """
+    linear = np.clip(np.asarray(linear, dtype=np.float32), 0.0, 1.0)
+    low = linear * np.float32(12.92)
+    high = np.float32(1.055) * np.power(linear, np.float32(1 / 2.4)) - np.float32(0.055)
+    return np.where(linear <= np.float32(0.0031308), low, high).astype(np.float32, copy=False)

@@ -1,0 +1,218 @@
+"""The reusable recovery engine: one backend, one pair of images, plans that change."""
+
+import time
+
+from .backends import make_backend
+from .backends.base import RecoveryMaps
+from .contract import check_same_size, from_rgba_float, layout_of
+from .errors import InputError
+from .params import DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, Parameters, check_blend_space
+from .plan import analyse_pair, make_plan
+
+__all__ = ["Engine", "RecoveryMaps"]
+
+
+class Engine:
+    """A recovery engine that keeps its backend, shaders and images between runs.
+
+    Load a pair once with :meth:`set_images`, then call :meth:`recover` (or :meth:`compute`
+    when the result stays on the GPU) as often as the parameters change: nothing is
+    recompiled and nothing is uploaded again, and the safe default analyses each pair once.
+
+    Parameters
+    ----------
+    backend : {"auto", "gl", "numpy"}
+        ``"auto"`` uses GL and falls back to NumPy with a one-line warning when no OpenGL 3.3
+        context can be created.
+    context : moderngl.Context, optional
+        A context to borrow (a viewer's window); by default the engine makes a standalone
+        EGL (or platform default) context and owns it.
+
+    Examples
+    --------
+    >>> engine = Engine(backend="numpy")
+    >>> engine.set_images(original, filtered)              # doctest: +SKIP
+    >>> for sigma_e in (0.005, 0.01, 0.02):                 # doctest: +SKIP
+    ...     result = engine.recover(sigma_e=sigma_e)
+    """
+
+    def __init__(self, backend="auto", *, context=None):
+        self._impl = make_backend(backend, context)
+        self._layout = None
+        self._pair = None
+        self._loaded_space = None
+        self._analysis = None
+        self.last_seconds = None
+        #: Plan or None: what the last :meth:`compute` or :meth:`run` did (mode, blend space,
+        #: strength, and why).
+        self.last_plan = None
+
+    @property
+    def backend(self):
+        """str: ``"gl"`` or ``"numpy"``, the backend actually in use."""
+        return self._impl.name
+
+    @property
+    def capabilities(self):
+        """Capabilities: the backend's largest and preferred tile sides."""
+        return self._impl.capabilities
+
+    @property
+    def context(self):
+        """moderngl.Context or None: the GL context the engine renders in."""
+        return getattr(self._impl, "context", None)
+
+    @property
+    def size(self):
+        """tuple of int: ``(width, height)`` of the loaded pair, or None."""
+        return None if self._layout is None else (self._layout.width, self._layout.height)
+
+    def set_images(self, original, filtered, *, linear=False, blend_space=None):
+        """Check and load an image pair (uploads it once for GL).
+
+        Parameters
+        ----------
+        original, filtered : ndarray, shape (H, W) or (H, W, C), C in 1..4
+            uint8, uint16, or float in [0, 1]; grey, grey+alpha, RGB or RGBA. Channel counts
+            and dtypes may differ (a colour-to-grey filter gives a grey F for an RGB O).
+        linear : bool
+            True when both images hold linear-light values; by default they are sRGB-encoded.
+        blend_space : {"linear", "srgb"}, optional
+            Where the blend model is fitted and imposed. By default ``mode="safe"`` picks it
+            per image and ``mode="paper"`` uses ``"linear"``, the paper's choice and right for
+            optical (camera) antialiasing.
+
+        Raises
+        ------
+        InputError
+            On a shape, dtype, size mismatch, NaN or range the core cannot use.
+        """
+        o_layout = layout_of(original, "original")
+        f_layout = layout_of(filtered, "filtered")
+        check_same_size(o_layout, f_layout)
+        if blend_space is not None:
+            check_blend_space(blend_space)
+        self._layout = f_layout
+        self._pair = (original, o_layout, filtered, f_layout, bool(linear), blend_space)
+        self._analysis = None
+        self._load(blend_space or "linear")
+
+    def _load(self, space):
+        original, o_layout, filtered, f_layout, linear, _ = self._pair
+        self._impl.load(original, o_layout, filtered, f_layout, linear, space)
+        self._loaded_space = space
+
+    def _require_images(self):
+        if self._layout is None:
+            raise InputError("no images loaded: call set_images(original, filtered) first")
+
+    def plan(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
+             mode=DEFAULT_MODE):
+        """The Plan that :meth:`compute` would run for the loaded pair (analysed once per pair).
+
+        Returns
+        -------
+        Plan
+        """
+        self._require_images()
+        original, _, filtered, _, linear, blend_space = self._pair
+        parameters = Parameters(sigma_d, sigma_e, iterations)
+        if mode == "safe" and self._analysis is None:
+            self._analysis = analyse_pair(original, filtered, linear)
+        return make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space,
+                         analysis=self._analysis)
+
+    def compute(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
+                maps=False, mode=DEFAULT_MODE):
+        """Run the recovery and keep the result in the backend (on the GPU for GL).
+
+        Parameters
+        ----------
+        sigma_d, sigma_e : float
+            Model and edge scales (ranges in ``aarecovery.PARAMETERS``).
+        iterations : int
+            Jacobi iterations.
+        maps : bool
+            Also keep the intermediate maps for :meth:`maps`.
+        mode : {"safe", "paper"}
+            ``"safe"`` first analyses the loaded pair once (blend space, blur and point-wise
+            detection, strength calibration; see :attr:`last_plan`) so that recovery does
+            not make F worse; ``"paper"`` is Yang et al. (2011) exactly.
+        """
+        self.run(self.plan(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode), maps=maps)
+
+    def run(self, plan, *, maps=False):
+        """Run a resolved :class:`Plan` on the loaded pair; the result stays in the backend.
+
+        The plan may come from :meth:`plan` or, when one pair is recovered in tiles, from
+        ``aarecovery.plan.make_plan`` on the whole pair.
+        """
+        self._require_images()
+        if plan.blend_space != self._loaded_space:
+            self._load(plan.blend_space)
+        start = time.perf_counter()
+        self._impl.run(plan, maps)
+        self._impl.finish()
+        self.last_seconds = time.perf_counter() - start
+        self.last_plan = plan
+
+    def result(self):
+        """Read the last result back in the filtered image's shape and dtype.
+
+        Returns
+        -------
+        ndarray
+            Same shape and dtype as the `filtered` given to :meth:`set_images`.
+        """
+        self._require_images()
+        return from_rgba_float(self._impl.read_result(), self._layout)
+
+    def recover(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
+                mode=DEFAULT_MODE):
+        """Compute and return R: :meth:`compute` then :meth:`result`."""
+        self.compute(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode)
+        return self.result()
+
+    def maps(self):
+        """Return the intermediate maps of the last :meth:`compute` with ``maps=True``.
+
+        Returns
+        -------
+        RecoveryMaps
+        """
+        self._require_images()
+        return self._impl.read_maps()
+
+    def texture(self, name="result"):
+        """GL only: a texture of the engine, in its (possibly borrowed) context, for display.
+
+        Parameters
+        ----------
+        name : {"result", "original", "filtered", "alpha", "beta", "edge_strength", "residual"}
+            Images are straight RGBA; maps exist after ``compute(maps=True)``.
+
+        Returns
+        -------
+        EngineTexture
+            ``(texture, channel, linear)``: the moderngl texture, the channel holding a map
+            (None for RGBA images), and whether sampled values are linear light (display code
+            must then sRGB-encode them).
+        """
+        if self.backend != "gl":
+            raise InputError("textures exist only on the GL backend; create the engine with backend='gl'")
+        self._require_images()
+        return self._impl.texture(name)
+
+    def release(self):
+        """Free textures and programs (and the context, if the engine made it)."""
+        self._impl.release()
+        self._layout = None
+        self._pair = None
+        self._analysis = None
+        self._loaded_space = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.release()

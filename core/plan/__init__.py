@@ -1,0 +1,50 @@
+"""The plan layer: the mode and every per-image decision, resolved once into a Plan.
+
+``mode="paper"`` is the published method: linear light, full strength. ``mode="safe"``
+(the default) first analyses the pair (:mod:`aarecovery.plan.analysis`, which says what
+it decides and why) and may change the blend space, lower the strength or leave F as it is.
+Either way the result is a :class:`~aarecovery.backends.base.Plan` that the engine and
+every backend take as it is.
+"""
+
+from ..backends.base import Plan
+from ..params import check_blend_space, check_mode
+from .analysis import PairAnalysis, analyse, analyse_pair
+
+__all__ = ["make_plan", "Plan", "PairAnalysis", "analyse", "analyse_pair"]
+
+
+def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blend_space=None, analysis=None):
+    """Resolve the mode for one pair into a :class:`Plan`.
+
+    Parameters
+    ----------
+    original, filtered : ndarray
+        The checked pair as the caller gave it (read only with ``mode="safe"``, and then
+        only a central crop).
+    parameters : Parameters
+        The checked user parameters.
+    mode : {"safe", "paper"}
+    linear : bool
+        The images hold linear-light values.
+    blend_space : {"linear", "srgb"}, optional
+        Overrides the space the mode would choose.
+    analysis : PairAnalysis, optional
+        The pair's analysis when it is already known (an engine keeps it per pair, so that a
+        slider change does not analyse again).
+
+    Returns
+    -------
+    Plan
+    """
+    check_mode(mode)
+    if blend_space is not None:
+        check_blend_space(blend_space)
+    common = dict(sigma_d=parameters.sigma_d, sigma_e=parameters.sigma_e, iterations=parameters.iterations)
+    if mode == "paper":
+        return Plan(**common, blend_space=blend_space or "linear", mode="paper",
+                    reason="the published method (Yang et al. 2011), without the safe default's analysis")
+    if analysis is None:
+        analysis = analyse_pair(original, filtered, linear)
+    return Plan(**common, blend_space=blend_space or analysis.blend_space, strength=analysis.strength,
+                pure_colours=analysis.pure_colours, mode="safe", reason=analysis.reason)

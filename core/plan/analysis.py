@@ -1,0 +1,143 @@
+"""The safe default's look at a whole pair (O, F): what to repair, where, and how strongly.
+
+The paper's method (``mode="paper"``) harms some inputs measurably (``docs/quality.md``):
+Gaussian blur, whose soft edges it re-sharpens, and natural photos under smooth filters,
+whose texture the two-colour model flattens. A user cannot know which case they are in,
+so ``mode="safe"`` first looks at the pair as a whole and decides, in this order:
+
+1. **Blend space** (``blend_space``): linear light or sRGB values, from which space O's
+   edges fit colour lines better.
+2. **Low-pass filters** (``lowpass``): if F is a blur of O, F's soft edges are the filter's
+   intent and F is kept.
+3. **Point-wise filters** (``pointwise``): when ``F = f(O)`` for a fitted table, hard-edged
+   content gets full strength and, for a monotone table, the pure colours of thin features
+   (``pure_colours``); textured content (a photo) gets the strength that
+   self-calibration at half resolution finds safe (``calibration``).
+4. **Other filters on textured images**: no way to simulate the filter and texture the
+   model would flatten: F is kept. On hard-edged content the paper's passes run.
+
+All of it runs once, in NumPy, on a central crop, before tiling, and results in a
+:class:`PairAnalysis` that ``aarecovery.plan.make_plan`` turns into the backends' Plan.
+"""
+
+from dataclasses import dataclass
+
+from ..colour import linear_to_srgb
+from ..contract import layout_of, to_rgba_float
+from ..params import ITERATIONS, SIGMA_D, SIGMA_E
+from ..spec.sobel import gradient_magnitude
+from .blend_space import choose_blend_space
+from .calibration import EDGE_GRADIENT, calibrate_strength
+from .lowpass import fit_lowpass
+from .pointwise import POINTWISE_SHARE, fit_pointwise
+from .pure_colours import pure_colour_prior
+
+__all__ = ["PairAnalysis", "analyse", "analyse_pair", "analysis_crop"]
+
+# Analysis works on at most this many pixels per side (a central crop): every statistic
+# below is a global average that a 512 x 512 window estimates well, and it bounds the cost
+# of self-calibration to a few tenths of a second.
+_ANALYSIS_SIDE = 512
+# Texture: mean normalised colour-line residual of O's edge pixels above which the image is
+# treated as a photo. Synthetic scenes measured 0.000-0.005, photos 0.03-0.05.
+_TEXTURE_RESIDUAL = 0.015
+# Strength for neighbourhood (not point-wise, not low-pass) filters on photos: the paper's
+# method lost up to 3.4 dB there (unsharp mask, colour replacement) and gained at most 1 dB
+# (bilateral); no strength was safe for all, so F is kept.
+_PHOTO_NEIGHBOURHOOD_STRENGTH = 0.0
+
+
+@dataclass(frozen=True)
+class PairAnalysis:
+    """What the safe default decided for one image pair.
+
+    Attributes
+    ----------
+    blend_space : {"linear", "srgb"}
+    strength : float
+        Multiplies the confidence ``beta``; 0 returns F unchanged, 1 is the paper's method.
+    reason : str
+        One line saying why, for messages and the evaluation report.
+    pure_colours : PureColourPrior or None
+        For point-wise filters on hard-edged content: the filter's table and O's flat
+        colours, with which the passes restore thin features.
+    """
+
+    blend_space: str
+    strength: float
+    reason: str
+    pure_colours: object = None
+
+
+def analysis_crop(image):
+    """The central crop of at most 512 x 512 pixels that the analysis reads."""
+    height, width = image.shape[:2]
+    top = max(0, (height - _ANALYSIS_SIDE) // 2)
+    left = max(0, (width - _ANALYSIS_SIDE) // 2)
+    return image[top:top + _ANALYSIS_SIDE, left:left + _ANALYSIS_SIDE]
+
+
+def analyse_pair(original, filtered, linear=False):
+    """:func:`analyse` on a pair as the caller gave it (any layout and dtype of the contract).
+
+    Only the crop is converted to float: a 20000 x 20000 pair would otherwise take 13 GB
+    just for the conversion.
+    """
+    o_crop, f_crop = analysis_crop(original), analysis_crop(filtered)
+    return analyse(to_rgba_float(o_crop, layout_of(o_crop, "original"), "original"),
+                   to_rgba_float(f_crop, layout_of(f_crop, "filtered"), "filtered"), linear_input=bool(linear))
+
+
+def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default,
+            iterations=ITERATIONS.default):
+    """Decide blend space, strength and pure colours for one pair (the safe default).
+
+    Parameters
+    ----------
+    original_rgba, filtered_rgba : ndarray of float32, shape (H, W, 4)
+        The pair in the core contract (straight alpha); only the central crop is read.
+    linear_input : bool
+        True when the colour is linear light.
+    sigma_d, sigma_e, iterations
+        The parameters the calibration runs at (the paper's: the analysis is a property of
+        the pair, so that a slider change never re-runs it).
+
+    Returns
+    -------
+    PairAnalysis
+    """
+    o_rgba = analysis_crop(original_rgba)
+    f_rgba = analysis_crop(filtered_rgba)
+    space, residuals = choose_blend_space(o_rgba, linear_input)
+    # The remaining analysis is on sRGB-encoded colour, as filters see it.
+    o = o_rgba[..., :3] if not linear_input else linear_to_srgb(o_rgba[..., :3])
+    f = f_rgba[..., :3] if not linear_input else linear_to_srgb(f_rgba[..., :3])
+    fit = residuals[space]
+    lowpass, kernel_residual, _ = fit_lowpass(o, f)
+    if lowpass:
+        return PairAnalysis(space, 0.0, f"F is a low-pass (blur) of O (kernel residual {kernel_residual:.3f}): kept F")
+    edges = gradient_magnitude(o) >= EDGE_GRADIENT
+    transfer = fit_pointwise(o, f, edges)
+    textured = fit is not None and fit > _TEXTURE_RESIDUAL
+    if transfer.consistency >= POINTWISE_SHARE and not textured:
+        # Hard-edged content: calibration would be biased here, since O is not a sharp
+        # scene at twice the resolution (its edges are already blends) and box2(F) keeps
+        # F's damage; measured, it chose strengths of 0.25-0.5 that lost 3-8 dB of the
+        # paper's gain on synthetic scenes. Full strength is the measured best.
+        # With a monotone per-channel or luma table, thin features get their pure colours:
+        # quick suite 0.600 -> 0.712 (linear), 0.628 -> 0.686 (sRGB); the table's ends
+        # extended by a power law: 0.774 / 0.734.
+        prior = pure_colour_prior(o, transfer)
+        return PairAnalysis(space, 1.0, f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges "
+                                        "match) on hard-edged content: full strength"
+                                        + (", pure colours of thin features" if prior is not None else ""), prior)
+    if transfer.consistency >= POINTWISE_SHARE:
+        strength, _ = calibrate_strength(o, transfer, f, space, sigma_d, sigma_e, iterations)
+        return PairAnalysis(space, strength,
+                            f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges match); "
+                            f"half-resolution calibration chose strength {strength:g}")
+    if textured:
+        return PairAnalysis(space, _PHOTO_NEIGHBOURHOOD_STRENGTH,
+                            f"neighbourhood filter on a textured image (colour-line residual {fit:.3f}): "
+                            f"strength {_PHOTO_NEIGHBOURHOOD_STRENGTH:g}")
+    return PairAnalysis(space, 1.0, "neighbourhood filter on hard-edged content: full strength")

@@ -1,0 +1,69 @@
+"""The recovery passes in pipeline order: the NumPy specification the GL backend follows.
+
+Each function is one pass, and the GL backend has a shader pass of the same name
+(``backends/gl/shaders/<name>.frag``) that ``tests/test_gl_parity.py`` compares with it:
+
+1. :func:`to_working_space`: O and F into premultiplied RGBA in the blend space.
+2. :func:`fit_blend_model`: the two-colour model of O and its confidence at every pixel
+   (the paper's, or with the safe default's pure colours of thin features).
+3. :func:`jacobi_step`, ``iterations`` times, starting from R = F.
+4. :func:`from_working_space`: back to straight RGBA in the input's encoding.
+
+:func:`recover_working` runs steps 2 and 3; it is the one place the Jacobi loop is written.
+"""
+
+from .blend_model import fit_paper_model
+from .jacobi import jacobi_step
+from .pure_colours import fit_pure_colour_model
+from .working_space import from_working_space, to_working_space
+
+__all__ = ["to_working_space", "fit_blend_model", "jacobi_step", "from_working_space", "recover_working"]
+
+
+def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=None, blend_space="linear"):
+    """Fit the two-colour blend model at every pixel of O (section 3.1) and its confidence.
+
+    The GL pass of this name also writes the first Jacobi iterate, which it can form from
+    the F texels it already fetched for Sobel; its twin here is ``jacobi_step(F, F, model)``.
+
+    Parameters
+    ----------
+    original, filtered : ndarray of float32, shape (H, W, 4)
+        O and F in the working space.
+    sigma_d, sigma_e : float
+        The model's colour-line and edge scales (``aarecovery.params``).
+    strength : float
+        Multiplies the confidence ``beta``: the safe default's per-image repair strength;
+        1 is the paper's method and leaves ``beta`` bit-identical.
+    prior : PureColourPrior, optional
+        The safe default's pure colours of thin features, for point-wise filters on
+        hard-edged content (``aarecovery.spec.pure_colours``); None is the paper's method.
+    blend_space : {"linear", "srgb"}
+        The working space's colour space, needed only with `prior` (its table is on
+        sRGB-encoded values).
+
+    Returns
+    -------
+    BlendModel
+    """
+    if prior is None:
+        return fit_paper_model(original, filtered, sigma_d, sigma_e, strength)
+    return fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space)
+
+
+def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1.0, prior=None,
+                    blend_space="linear"):
+    """Fit the model and run the Jacobi iterations on working-space images.
+
+    Parameters are those of :func:`fit_blend_model`, and `iterations` (0 returns F).
+
+    Returns
+    -------
+    recovered : ndarray of float32, shape (H, W, 4)
+    model : BlendModel
+    """
+    model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space)
+    recovered = filtered
+    for _ in range(iterations):
+        recovered = jacobi_step(recovered, filtered, model)
+    return recovered, model

@@ -1,0 +1,404 @@
+"""Pure colours of thin features, for point-wise filters on hard-edged content (safe default).
+
+The paper blends the recovered colours found at the two extreme pixels of the 3x3
+neighbourhood. Text of 7-16 px, lines under 1.5 px and converging wedges never show a pure
+ink pixel: their darkest pixel is itself a blend, so the paper blends between colours that
+are already mixed (measured: 35-60 % of the error recovered there, against 85-95 % on
+shapes). When the filter is point-wise, ``F = f(O)``, and ``f`` is known as a lookup table
+(``aarecovery.plan.pointwise``), the pure colour of such a feature can be estimated and
+filtered directly:
+
+* An extreme pixel q holds a thin feature's partial colour when it is a **ridge** along the
+  colour line: some pair of opposite neighbours of q (N/S, W/E or a diagonal pair) both lie
+  on the line and both are less extreme than q by more than a tenth of the line's span.
+* It is **not** a partial colour when it is one of the image's flat colours (the
+  **palette**: colours of pixels whose whole 3x3 neighbourhood is equal, the 32 most
+  frequent), or when q lies on the image border (a feature cut by the border looks thin).
+* Nor when q is O's darkest or brightest colour (every key within 1/255 of an end of O's key
+  range) and the other extreme is neither O's opposite end nor a flat colour: the dark paper
+  between 0.5 px white lines has no flat pixel, but it is pure; extended to black it turned
+  the whole paper into a blend of f(black) and f(white). Black lines on white alone still
+  extend their darkest pixel (the other extreme is the white end). Quick suite sRGB 0.734 ->
+  0.761, linear 0.774 -> 0.780 (lines/sRGB: equalize 0.40 -> 0.74, posterize 0.43 -> 0.63,
+  gamma 0.61 -> 0.72); full 0.789 -> 0.806, 0.790 -> 0.794; no case lost.
+* A partial colour is extended along the colour line, away from the other extreme, to the
+  edge of the colour cube (the prior: inks of thin features are saturated, black or white,
+  as in text and line art). Its filtered colour is ``f`` of that, from the table, provided
+  the table reproduces F at the observed extreme (within 0.02) and is keyed per channel or
+  by luma; keys on the mean or maximum channel matched F only by coincidence on images of
+  few colours (colour-to-grey on the line scene) and predicted nonsense off them.
+* Coverage ``alpha`` is re-measured against the extended colours, and the Jacobi step
+  blends the fixed filtered colours in place of ``R`` at the extreme pixels.
+
+* Tone mapping and histogram equalization are not functions of each channel or of luma on
+  colour content: they map luma (equalization, encoded values) or luminance (tone mapping,
+  linear light) and scale the colour with it. The scale keys (:data:`SCALE_KEYS`,
+  :func:`scale_transfer`) are that form; with them the extension covers those filters
+  (quick suite: tonemap on text/lines 0.39-0.52 -> 0.72-0.96, equalize 0.37-0.47 -> 0.81-0.90).
+
+* The table must be monotone (``aarecovery.plan.pure_colours.is_monotone``): tables that
+  match colour to grey or a hue swap by coincidence are not, and extending with them lost
+  up to 7.9 dB (chart).
+
+Measured (synthetic scenes, blur excluded, mean edge-band error reduction): quick suite
+linear 0.600 -> 0.712, sRGB 0.628 -> 0.686; full suite 0.642 -> 0.751 and 0.681 -> 0.749;
+thresholded 7 px text 0.51 -> 0.93, thin lines 0.43 -> 0.95; no case worse than F. A stricter purity test (a pixel with an equally
+extreme neighbour whose opposite is lower is pure) protected shapes as well as the palette
+but gave back most of the gain on text, whose strokes straddle two pixels.
+
+This module is the NumPy specification; ``pure_colours.glsl``, included by the GL fit pass
+(``#if PURE_COLOURS``), is its GL twin. ``aarecovery.plan.pure_colours`` builds the prior.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..colour import LUMA_WEIGHTS, linear_to_srgb, srgb_to_linear
+from .blend_model import BlendModel, confidence, coverage, fit_extremes
+from .neighbourhood import NEIGHBOUR_OFFSETS, dot, neighbours, planes
+from .sobel import sobel_magnitude
+
+__all__ = ["PureColourPrior", "PALETTE_SIZE", "EXTENSION_KEYS", "SCALE_KEYS", "filtered_colour", "extend_extreme",
+           "scale_transfer", "key_values", "fit_pure_colour_model"]
+
+#: Most palette colours kept (a uniform array in the GL pass).
+PALETTE_SIZE = 32
+# An extreme colour within this distance (working space) of a palette colour is pure.
+PALETTE_TOLERANCE = 0.03
+# Ridge test: neighbours count when they lie within this distance of the colour line, and
+# are "less extreme" when lower by more than this share of the line's span.
+LINE_TOLERANCE = 0.05
+RIDGE_MARGIN = 0.1
+# The table must reproduce F at the observed extreme within this (working space).
+EXPLAIN_TOLERANCE = 0.02
+#: Table keys for which the extension is used (see the module notes).
+EXTENSION_KEYS = ("channel", "luma", "luma_scale", "luminance_scale")
+_KEY_CODES = {"channel": 0, "luma": 1, "luma_scale": 2, "luminance_scale": 3}
+#: Keys whose table maps a luma to a new luma and scales the colour with it (keeping hue):
+#: ``"luma_scale"`` on encoded values (histogram equalization), ``"luminance_scale"`` on
+#: linear light (tone mapping). Column 0 of the table holds the mapped value; black (key
+#: 0) maps to that grey.
+SCALE_KEYS = ("luma_scale", "luminance_scale")
+_SCALE_BLACK = 1e-6
+_LUMA = LUMA_WEIGHTS
+# (i, j) pairs of opposite neighbours as indices into NEIGHBOUR_OFFSETS.
+OPPOSITE_PAIRS = ((1, 4), (2, 3), (5, 8), (6, 7))
+
+
+@dataclass(frozen=True)
+class PureColourPrior:
+    """What the extension needs besides O and F: the filter's table and the flat colours.
+
+    Attributes
+    ----------
+    key : {"channel", "luma", "luma_scale", "luminance_scale"}
+        How :attr:`table` is indexed: each channel of the encoded colour, or its luma; the
+        scale keys map luma (encoded) or luminance (linear) and scale colour with it
+        (:func:`scale_transfer`).
+    table : ndarray of float32, shape (256, 3)
+        Encoded output colour per bin of the key; read with linear interpolation between
+        bin centres ``(i + 0.5) / 256``.
+    palette : ndarray of float32, shape (N, 3), N <= PALETTE_SIZE
+        sRGB-encoded flat colours of O.
+    key_low, key_high : ndarray of float32, shape (3,), optional
+        The key range O shows (bin centres of the table's first and last filled bins, per
+        column; the scale keys use column 0). Beyond it the table is extrapolated
+        (``aarecovery.plan.pure_colours.extrapolate_table``); an extreme whose key lies at an end of the range (within
+        :data:`RANGE_TOLERANCE`) is read with its keys clamped to the range, as before the
+        extrapolation (see :func:`extend_extreme`). Default: no clamping.
+    """
+
+    key: str
+    table: np.ndarray
+    palette: np.ndarray
+    key_low: np.ndarray = None
+    key_high: np.ndarray = None
+
+    def key_range(self):
+        """Observed key range (bin centres of the first and last filled bins), each shape (3,)."""
+        low = np.zeros(3, np.float32) if self.key_low is None else np.asarray(self.key_low, np.float32)
+        high = np.ones(3, np.float32) if self.key_high is None else np.asarray(self.key_high, np.float32)
+        return low, high
+
+    @property
+    def key_code(self):
+        """int: 0 ``"channel"``, 1 ``"luma"``, 2 ``"luma_scale"``, 3 ``"luminance_scale"`` (GL uniform)."""
+        return _KEY_CODES[self.key]
+
+    def palette_in(self, blend_space):
+        """The palette as opaque working-space colours, ndarray of float32, shape (N, 3)."""
+        colour = self.palette.astype(np.float32)
+        return srgb_to_linear(colour) if blend_space == "linear" else colour
+
+
+def _table_at(column, keys):
+    """Linear interpolation of a table column between bin centres ``(i + 0.5) / 256``."""
+    position = np.clip(keys * np.float32(256) - np.float32(0.5), 0, 255).astype(np.float32)
+    lower = np.minimum(np.floor(position).astype(np.intp), 254)
+    fraction = position - lower.astype(np.float32)
+    below, above = column[lower], column[lower + 1]
+    return below + (above - below) * fraction
+
+
+def scale_transfer(encoded, key, table, keys=None):
+    """A scale key's ``f``: map the luma (or luminance) by the table, scale colour with it.
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (3, N)
+        sRGB-encoded colour planes.
+    key : {"luma_scale", "luminance_scale"}
+    table : ndarray of float32, shape (256, 3)
+        Column 0: the mapped luma (encoded) or luminance (linear) per bin.
+    keys : ndarray of float32, shape (N,), optional
+        The table key to read at, when it differs from the colour's own luma (clamped to
+        O's range, see :func:`filtered_colour`).
+
+    Returns
+    -------
+    ndarray of float32, shape (3, N)
+        Encoded ``f(encoded)``, clipped to [0, 1].
+    """
+    values = srgb_to_linear(encoded.T).T if key == "luminance_scale" else encoded
+    values = values.astype(np.float32)
+    luma = values[0] * _LUMA[0] + values[1] * _LUMA[1] + values[2] * _LUMA[2]
+    mapped = _table_at(table[:, 0], luma if keys is None else keys).astype(np.float32)
+    lit = luma > np.float32(_SCALE_BLACK)
+    ratio = mapped / np.where(lit, luma, np.float32(1))
+    out = np.clip(np.where(lit, values * ratio, mapped), 0, 1).astype(np.float32)
+    return (linear_to_srgb(out.T).T if key == "luminance_scale" else out).astype(np.float32)
+
+
+def _encoded_of(colour, blend_space):
+    alpha = colour[3]
+    visible = alpha > 0
+    straight = np.clip(colour[:3] / np.where(visible, alpha, np.float32(1)), 0, 1).astype(np.float32)
+    return (linear_to_srgb(straight.T).T if blend_space == "linear" else straight).astype(np.float32)
+
+
+def key_values(encoded, key):
+    """The table keys of encoded colour planes ``(3, N)``: shape (3, N), one row per table
+    column (luma and the scale keys repeat one value)."""
+    if key in SCALE_KEYS:
+        values = srgb_to_linear(encoded.T).T.astype(np.float32) if key == "luminance_scale" else encoded
+        luma = values[0] * _LUMA[0] + values[1] * _LUMA[1] + values[2] * _LUMA[2]
+        return np.broadcast_to(luma, encoded.shape)
+    if key == "luma":
+        return np.broadcast_to(encoded[0] * _LUMA[0] + encoded[1] * _LUMA[1] + encoded[2] * _LUMA[2],
+                               encoded.shape)
+    return encoded
+
+
+def filtered_colour(colour, prior, blend_space, low_end=None, high_end=None):
+    """``f`` of working-space colours, by the prior's table.
+
+    Parameters
+    ----------
+    colour : ndarray of float32, shape (4, N)
+        Premultiplied working-space colours (channel planes).
+    prior : PureColourPrior
+    blend_space : {"linear", "srgb"}
+    low_end, high_end : ndarray of bool, shape (3, N), optional
+        Where to clamp the keys to O's key range from below / above (per table column).
+
+    Returns
+    -------
+    ndarray of float32, shape (4, N)
+        Premultiplied working-space ``f(colour)``, with the colour's own alpha.
+    """
+    alpha = colour[3]
+    encoded = _encoded_of(colour, blend_space)
+    keys = key_values(encoded, prior.key)
+    if low_end is not None:
+        low, high = prior.key_range()
+        keys = np.where(low_end, np.maximum(keys, low[:, None]), keys)
+        keys = np.where(high_end, np.minimum(keys, high[:, None]), keys).astype(np.float32)
+    if prior.key in SCALE_KEYS:
+        out = scale_transfer(encoded, prior.key, prior.table, keys[0])
+    else:
+        out = np.stack([_table_at(prior.table[:, c], keys[c]) for c in range(3)]).astype(np.float32)
+    decoded = srgb_to_linear(np.clip(out, 0, 1).T).T if blend_space == "linear" else out
+    return np.concatenate([decoded * alpha, alpha[None]], axis=0).astype(np.float32)
+
+
+#: An extreme whose key lies within this of an end of O's key range is read with the
+#: table clamped there (see :class:`PureColourPrior`).
+RANGE_TOLERANCE = 0.05
+#: An extreme whose keys all lie within this of an end of O's key range is O's darkest or
+#: brightest colour (see :func:`extend_extreme`).
+END_TOLERANCE = 1.0 / 255
+
+
+def extend_extreme(far, near, around, filtered_far, on_border, palette, prior, blend_space):
+    """Decide whether an extreme colour is a thin feature's partial colour, and extend it.
+
+    Parameters
+    ----------
+    far : ndarray of float32, shape (4, N)
+        The extreme colour of O being tested (at pixel q).
+    near : ndarray of float32, shape (4, N)
+        The other extreme.
+    around : list of 9 ndarray of float32, shape (4, N)
+        O around q in ``NEIGHBOUR_OFFSETS`` order.
+    filtered_far : ndarray of float32, shape (4, N)
+        F at q.
+    on_border : ndarray of bool, shape (N,)
+        q lies on the image border.
+    palette : ndarray of float32, shape (P, 3)
+        Opaque working-space flat colours.
+    prior : PureColourPrior
+    blend_space : {"linear", "srgb"}
+
+    Returns
+    -------
+    extended : ndarray of bool, shape (N,)
+    colour : ndarray of float32, shape (4, N)
+        The pure colour: `far` extended to the colour cube where `extended`, else `far`.
+    filtered : ndarray of float32, shape (4, N)
+        ``f(colour)`` where `extended` (unused elsewhere).
+    """
+    span = far - near
+    length = np.sqrt(dot(span, span))
+    defined = length > np.float32(1e-6)
+    direction = span / np.where(defined, length, np.float32(1))
+    t_far = dot(far - near, direction)
+    limit = t_far - np.float32(RIDGE_MARGIN) * length
+    reach_sq = np.float32(LINE_TOLERANCE * LINE_TOLERANCE)
+    ridge = np.zeros(length.shape, bool)
+    for i, j in OPPOSITE_PAIRS:
+        first, second = around[i] - near, around[j] - near
+        t_first, t_second = dot(first, direction), dot(second, direction)
+        on_line = (dot(first, first) - t_first * t_first < reach_sq) & \
+            (dot(second, second) - t_second * t_second < reach_sq)
+        ridge |= on_line & (t_first < limit) & (t_second < limit)
+    candidate = defined & ridge & ~on_border
+    for colour in palette:
+        miss = far[:3] - colour[:, None] * far[3]
+        candidate &= miss[0] * miss[0] + miss[1] * miss[1] + miss[2] * miss[2] \
+            >= np.float32(PALETTE_TOLERANCE * PALETTE_TOLERANCE)
+    # The table must explain F at the observed extreme.
+    explained = filtered_colour(far, prior, blend_space)
+    miss = np.abs(explained - filtered_far)[:3].max(axis=0)
+    candidate &= miss < np.float32(EXPLAIN_TOLERANCE)
+    # Largest s >= 1 with near + s (far - near) inside the premultiplied colour cube:
+    # 0 <= rgb <= alpha <= 1.
+    reach = np.full(length.shape, np.float32(1e6))
+    for c in range(4):
+        step = span[c] - (span[3] if c < 3 else 0)
+        room_up = (near[3] if c < 3 else np.float32(1)) - near[c]
+        up = np.where(step > 1e-9, room_up / np.where(step > 1e-9, step, 1), np.float32(1e6))
+        down = np.where(span[c] < -1e-9, -near[c] / np.where(span[c] < -1e-9, span[c], -1), np.float32(1e6))
+        reach = np.minimum(reach, np.minimum(up, down))
+    reach = np.maximum(reach, np.float32(1)).astype(np.float32)
+    low_end = high_end = None
+    if prior.key_low is not None:
+        low, high = prior.key_range()
+        far_keys = key_values(_encoded_of(far, blend_space), prior.key)
+        tolerance = np.float32(RANGE_TOLERANCE)
+        low_end = far_keys <= low[:, None] + tolerance
+        high_end = far_keys >= high[:, None] - tolerance
+        # O's darkest (brightest) colour is pure, a paper between thin lines rather than a
+        # blend of unseen ink, unless the other extreme is O's opposite end or a flat colour:
+        # then the window is a thin feature on its paper, and its darkest pixel may be the
+        # darkest of the image (0.7 px black lines on white alone). Extending the dark paper
+        # between 0.5 px white lines to black recovered the whole paper as a blend of f(black)
+        # and f(white) (lines/sRGB: equalize 0.40, posterize 0.43, gamma 0.61).
+        end = np.float32(END_TOLERANCE)
+        near_keys = key_values(_encoded_of(near, blend_space), prior.key)
+        near_pure = np.zeros(length.shape, bool)
+        for colour in palette:
+            miss = near[:3] - colour[:, None] * near[3]
+            near_pure |= miss[0] * miss[0] + miss[1] * miss[1] + miss[2] * miss[2] \
+                < np.float32(PALETTE_TOLERANCE * PALETTE_TOLERANCE)
+        far_low = (far_keys <= low[:, None] + end).all(axis=0)
+        far_high = (far_keys >= high[:, None] - end).all(axis=0)
+        near_low = (near_keys <= low[:, None] + end).all(axis=0)
+        near_high = (near_keys >= high[:, None] - end).all(axis=0)
+        candidate &= ~((far_low & ~near_high | far_high & ~near_low) & ~near_pure)
+    colour = np.where(candidate, near + reach * span, far).astype(np.float32)
+    # At an end of O's range the extreme is read with the table clamped there: a dark paper
+    # between thin white lines is O's darkest colour, not a blend of unseen ink.
+    filtered = filtered_colour(colour, prior, blend_space, low_end, high_end)
+    return candidate, colour, filtered
+
+
+def fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space):
+    """``fit_blend_model`` with the pure colours of thin features (the safe default).
+
+    For point-wise filters on hard-edged content (see the module notes for the rule and its
+    measurements): an extreme that is a thin feature's partial colour is extended along the
+    colour line to the colour cube, its filtered colour is taken from the filter's table, and alpha is measured against the extended colours. The edge
+    strength uses O's gradient times the larger of F's gradient and the contrast of the
+    two filtered extremes, since a thin feature that the filter erased from F (a light
+    stroke thresholded away) leaves F flat where it must be restored; measured, this added
+    0.05 to the quick suite's mean error reduction on linear-light scenes.
+
+    Parameters
+    ----------
+    original, filtered : ndarray of float32, shape (H, W, 4)
+        O and F in the working space.
+    sigma_d, sigma_e, strength
+        As for ``aarecovery.spec.blend_model.fit_paper_model``.
+    prior : PureColourPrior
+    blend_space : {"linear", "srgb"}
+
+    Returns
+    -------
+    BlendModel
+        With `pure_a`, `pure_b`, `fixed_a` and `fixed_b` set.
+    """
+    height, width = original.shape[:2]
+    o_planes, f_planes = planes(original), planes(filtered)
+    colours = neighbours(o_planes)
+    f_colours = neighbours(f_planes)
+    original_gradient = sobel_magnitude(colours).astype(np.float32)
+    filtered_gradient = sobel_magnitude(f_colours).astype(np.float32)
+    shape = (height, width)
+    alpha = np.full(shape, 0.5, np.float32)
+    beta = np.zeros(shape, np.float32)
+    residual = np.zeros(shape, np.float32)
+    edge = np.zeros(shape, np.float32)
+    index_a = np.zeros(shape, np.uint8)
+    index_b = np.zeros(shape, np.uint8)
+    pure_a = np.zeros(shape, bool)
+    pure_b = np.zeros(shape, bool)
+    fixed_a = np.zeros(shape + (4,), np.float32)
+    fixed_b = np.zeros(shape + (4,), np.float32)
+    # Where O is flat, e_p is 0 whatever F does: nothing to fit.
+    fitted = original_gradient > 0
+    if fitted.any():
+        rows, cols = np.nonzero(fitted)
+        columns = [colour[:, fitted] for colour in colours]
+        col_alpha, col_residual, col_a, col_b, colour_a, colour_b = fit_extremes(columns, sigma_d)
+        offsets = np.asarray(NEIGHBOUR_OFFSETS, dtype=np.int64)
+        padded_o = np.pad(o_planes, ((0, 0), (2, 2), (2, 2)), mode="edge")
+        palette = prior.palette_in(blend_space)
+
+        def at(values, pad, row, col):
+            return values[:, np.clip(row, -pad, height - 1 + pad) + pad, np.clip(col, -pad, width - 1 + pad) + pad]
+
+        def extend(index, far, near):
+            q_row, q_col = rows + offsets[index, 0], cols + offsets[index, 1]
+            border = (q_row <= 0) | (q_row >= height - 1) | (q_col <= 0) | (q_col >= width - 1)
+            around = [at(padded_o, 2, q_row + dy, q_col + dx) for dy, dx in NEIGHBOUR_OFFSETS]
+            filtered_far = f_planes[:, np.clip(q_row, 0, height - 1), np.clip(q_col, 0, width - 1)]
+            extended, pure, fixed = extend_extreme(far, near, around, filtered_far, border, palette, prior,
+                                                   blend_space)
+            return extended, pure, np.where(extended, fixed, filtered_far)
+
+        extended_a, pure_colour_a, start_a = extend(col_a, colour_a, colour_b)
+        extended_b, pure_colour_b, start_b = extend(col_b, colour_b, colour_a)
+        either = extended_a | extended_b
+        col_alpha = np.where(either, coverage(columns[0], pure_colour_a, pure_colour_b), col_alpha)
+        contrast = np.sqrt(dot(start_a - start_b, start_a - start_b))
+        col_edge = (original_gradient[fitted] * np.maximum(filtered_gradient[fitted], contrast)).astype(np.float32)
+        alpha[fitted] = col_alpha
+        residual[fitted] = col_residual
+        edge[fitted] = col_edge
+        beta[fitted] = confidence(col_residual, col_edge, sigma_d, sigma_e, strength)
+        index_a[fitted], index_b[fitted] = col_a, col_b
+        pure_a[fitted], pure_b[fitted] = extended_a, extended_b
+        fixed_a[fitted] = np.where(extended_a, start_a, 0).T
+        fixed_b[fitted] = np.where(extended_b, start_b, 0).T
+    return BlendModel(alpha, beta, index_a, index_b, residual, edge, pure_a, pure_b, fixed_a, fixed_b)
