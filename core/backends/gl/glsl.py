@@ -9,7 +9,7 @@ import re
 from functools import lru_cache
 from importlib import resources
 
-__all__ = ["load_source", "ShaderSourceError"]
+__all__ = ["load_source", "read_source", "ShaderSourceError"]
 
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
 
@@ -19,7 +19,8 @@ class ShaderSourceError(RuntimeError):
 
 
 @lru_cache(maxsize=None)
-def _read(name):
+def read_source(name):
+    """The text of shader file `name` as stored (no includes expanded)."""
     try:
         return resources.files(__package__).joinpath("shaders", name).read_text(encoding="utf-8")
     except FileNotFoundError:
@@ -50,7 +51,7 @@ def load_source(name, defines=None):
         if file_name not in files:
             files.append(file_name)
         out = [f"#line 1 {number}"] if stack else []
-        for line_number, line in enumerate(_read(file_name).splitlines(), start=1):
+        for line_number, line in enumerate(read_source(file_name).splitlines(), start=1):
             match = _INCLUDE.match(line)
             if match is None:
                 out.append(line)

@@ -1,5 +1,7 @@
-// Exact piecewise sRGB transfer functions (IEC 61966-2-1): the GL backend's only colour maths.
-// The NumPy twin is aarecovery/_colour.py.
+// Exact piecewise sRGB transfer functions (IEC 61966-2-1) and the luma weights: the GL
+// backend's only colour maths. The NumPy twin is aarecovery/colour.py.
+
+const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);  // Rec. 709 (aarecovery.colour.LUMA)
 
 vec3 srgb_to_linear(vec3 encoded) {
     vec3 low = encoded * (1.0 / 12.92);
@@ -23,4 +25,11 @@ vec3 convert_colour(vec3 colour, int mode) {
     if (mode == CONVERT_DECODE) return srgb_to_linear(colour);
     if (mode == CONVERT_ENCODE) return linear_to_srgb(colour);
     return colour;
+}
+
+// Straight RGBA into the working space: colour converted by `mode`, then premultiplied.
+// Twin: to_working_space in aarecovery/spec/working_space.py.
+vec4 to_working(vec4 straight, int mode) {
+    straight = clamp(straight, 0.0, 1.0);  // float inputs may stray a hair outside [0, 1]
+    return vec4(convert_colour(straight.rgb, mode) * straight.a, straight.a);
 }

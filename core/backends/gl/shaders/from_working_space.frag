@@ -1,6 +1,6 @@
 #version 330 core
 // The last iterate (or F itself, for zero iterations) back to straight RGBA in the input
-// encoding. Twin: from_working_space in aarecovery/_reference.py.
+// encoding. Twin: from_working_space in aarecovery/spec/working_space.py.
 #include "working.glsl"
 
 uniform sampler2D recovered_work;

@@ -1,6 +1,6 @@
 // Pure colours of thin features (the safe default, point-wise filters on hard-edged content).
-// Twin: extend_extreme and filtered_colour in aarecovery/_pure_colours.py, which explains
-// the rule and its measurements. Included by fit_blend_model.frag after working.glsl.
+// Twin: extend_extreme and filtered_colour in aarecovery/spec/pure_colours.py, which explains
+// the rule and its measurements. Included after working.glsl, before blend_model.glsl.
 
 uniform sampler2D transfer_table;  // 256 x 1: the filter's table, encoded output per key bin
 uniform int table_key;             // 0: each channel indexes its own column, 1: luma indexes all,
@@ -18,7 +18,6 @@ const float RIDGE_MARGIN = 0.1;
 const float EXPLAIN_TOLERANCE = 0.02;
 const float RANGE_TOLERANCE = 0.05;
 const float END_TOLERANCE = 1.0 / 255.0;
-const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
 
 float table_at(float key, int channel) {
     // Linear interpolation between bin centres, two fetches (no texture filtering: llvmpipe's
@@ -124,7 +123,7 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
               || lower_pair(q + OFFSETS[6], q + OFFSETS[7], near, direction, t_far - margin, size);
     if (!ridge) return result;
     // An extreme that is O's darkest or brightest colour is pure (a paper between thin lines),
-    // unless the other extreme is the opposite end or a flat colour (_pure_colours.extend_extreme).
+    // unless the other extreme is the opposite end or a flat colour (spec/pure_colours.extend_extreme).
     if (clamp_ends != 0) {
         vec3 far_keys = key_values(encoded_of(far));
         vec3 near_keys = key_values(encoded_of(near));
@@ -153,7 +152,7 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
     result.extended = true;
     result.colour = near + reach * span;
     // At an end of O's key range the extreme is read with the table clamped there (a dark
-    // paper, not unseen ink: _pure_colours.extend_extreme).
+    // paper, not unseen ink: spec/pure_colours.extend_extreme).
     bvec3 low_end = bvec3(false), high_end = bvec3(false);
     if (clamp_ends != 0) {
         vec3 far_keys = key_values(encoded_of(far));

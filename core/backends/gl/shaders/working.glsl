@@ -1,20 +1,12 @@
 // The working space (premultiplied RGBA, colour in the blend space) and the way back.
-// Twin of to_working_space / from_working_space in aarecovery/_reference.py.
+// Twin of to_working_space / from_working_space in aarecovery/spec/working_space.py.
 // The backend defines OUTPUT_CONVERT (blend space -> input encoding) as a CONVERT_* mode.
 #include "colour.glsl"
+#include "neighbourhood.glsl"
 
 uniform sampler2D original_work;
 uniform sampler2D filtered_work;
 uniform sampler2D filtered_image;  // F as given, for the colour of fully transparent pixels
-
-// Neighbourhood order of NEIGHBOUR_OFFSETS (x = column, y = row): centre, N, W, E, S, NW, NE, SW, SE.
-const ivec2 OFFSETS[9] = ivec2[9](
-    ivec2(0, 0), ivec2(0, -1), ivec2(-1, 0), ivec2(1, 0), ivec2(0, 1),
-    ivec2(-1, -1), ivec2(1, -1), ivec2(-1, 1), ivec2(1, 1));
-
-ivec2 clamp_to_image(ivec2 p, ivec2 size) {
-    return clamp(p, ivec2(0), size - 1);
-}
 
 // Straight RGBA in the input encoding; a fully transparent result keeps F's colour, and a
 // pixel the recovery left exactly at F keeps F bit for bit (decode + encode is not exact).

@@ -1,0 +1,135 @@
+// Section 3.1 and equation 5 at one pixel: the two-colour blend model of O, its confidence,
+// and the first Jacobi iterate (R0 = F), formed from the F texels fetched for Sobel.
+// Twin: fit_blend_model and jacobi_step(F, F, model) in aarecovery/spec/passes.py.
+// Needs working.glsl and sobel.glsl first, and pure_colours.glsl with PURE_COLOURS.
+
+uniform float sigma_d;
+uniform float sigma_e;
+uniform float strength;  // the safe default's per-image repair strength; 1 for the paper
+
+const float TINY = 1e-12;
+const float FAINT = 1e-30;
+
+struct BlendFit {
+    vec4 model;           // alpha, beta, 9 * index_a + index_b (+ 81, 162: pure colours), residual
+    vec4 first_iterate;   // working space
+    float edge;           // edge strength e_p
+    vec4 fixed_a;         // f of the pure colour at extreme a, where the code says so
+    vec4 fixed_b;         // ... and at extreme b
+};
+
+// Roweis EM for one component is power iteration on the 4x4 scatter matrix (see the NumPy
+// twin, principal_direction), started at the neighbour farthest from the mean.
+vec4 principal_direction(vec4 c[9]) {
+    vec4 mean = vec4(0.0);
+    for (int i = 0; i < 9; ++i) mean += c[i];
+    mean /= 9.0;
+    vec4 x = vec4(0.0);
+    float farthest = -1.0;
+    float s00 = 0.0, s01 = 0.0, s02 = 0.0, s03 = 0.0, s11 = 0.0, s12 = 0.0, s13 = 0.0;
+    float s22 = 0.0, s23 = 0.0, s33 = 0.0;
+    for (int i = 0; i < 9; ++i) {
+        vec4 y = c[i] - mean;
+        float spread = dot(y, y);
+        if (spread > farthest) { farthest = spread; x = y; }
+        s00 += y.x * y.x; s01 += y.x * y.y; s02 += y.x * y.z; s03 += y.x * y.w;
+        s11 += y.y * y.y; s12 += y.y * y.z; s13 += y.y * y.w;
+        s22 += y.z * y.z; s23 += y.z * y.w; s33 += y.w * y.w;
+    }
+    for (int iteration = 0; iteration < 3; ++iteration) {
+        x = vec4(s00 * x.x + s01 * x.y + s02 * x.z + s03 * x.w,
+                 s01 * x.x + s11 * x.y + s12 * x.z + s13 * x.w,
+                 s02 * x.x + s12 * x.y + s22 * x.z + s23 * x.w,
+                 s03 * x.x + s13 * x.y + s23 * x.z + s33 * x.w);
+        x = x / sqrt(dot(x, x) + FAINT);
+    }
+    return x;
+}
+
+// Equation 5 times the strength.
+float confidence(float residual, float edge) {
+    float edge_ratio = edge / sigma_e;
+    float residual_ratio = residual / sigma_d;
+    float beta = exp(-residual_ratio * residual_ratio) * (1.0 - exp(-edge_ratio * edge_ratio));
+    if (strength != 1.0) beta *= strength;
+    return beta;
+}
+
+BlendFit fit_blend_model(ivec2 p, ivec2 size) {
+    BlendFit fit;
+    fit.fixed_a = vec4(0.0);
+    fit.fixed_b = vec4(0.0);
+    // F first: where F is flat the edge strength is exactly 0, so beta is 0 and the model
+    // is never used; skipping the fit there is what makes thresholded and posterized
+    // images (mostly flat) fast.
+    vec4 f[9];
+    for (int i = 0; i < 9; ++i) f[i] = texelFetch(filtered_work, clamp_to_image(p + OFFSETS[i], size), 0);
+    float filtered_gradient = sobel_magnitude(f);
+    vec4 c[9];
+    float edge = 0.0;
+#if PURE_COLOURS
+    // With pure colours, a thin feature that the filter erased leaves F flat where it must
+    // be restored: only a flat O means there is nothing to fit (see fit_pure_colour_model).
+    for (int i = 0; i < 9; ++i) c[i] = texelFetch(original_work, clamp_to_image(p + OFFSETS[i], size), 0);
+    float original_gradient = sobel_magnitude(c);
+    edge = original_gradient * filtered_gradient;
+    if (original_gradient == 0.0) {
+#else
+    if (filtered_gradient > 0.0) {
+        for (int i = 0; i < 9; ++i) c[i] = texelFetch(original_work, clamp_to_image(p + OFFSETS[i], size), 0);
+        edge = sobel_magnitude(c) * filtered_gradient;
+    }
+    if (edge == 0.0) {
+#endif
+        fit.edge = edge;
+        fit.model = vec4(0.5, 0.0, 0.0, 0.0);
+        fit.first_iterate = f[0];
+        return fit;
+    }
+
+    vec4 x = principal_direction(c);
+
+    // Extremes along the line through the centre, among neighbours within 3 sigma_d of it;
+    // the first of equal candidates wins (centre, then 4-neighbours, then diagonals).
+    // Extremes are carried as values, not indices: dynamic array indexing makes llvmpipe
+    // spill the arrays to memory.
+    float reach = 3.0 * sigma_d;
+    float reach_sq = reach * reach;
+    int a = 0;
+    int b = 0;
+    float t_max = 0.0;
+    float t_min = 0.0;
+    vec4 c_a = c[0], c_b = c[0], f_a = f[0], f_b = f[0];
+    for (int i = 1; i < 9; ++i) {
+        vec4 offset = c[i] - c[0];
+        float t = dot(offset, x);
+        if (dot(offset, offset) - t * t < reach_sq) {
+            if (t > t_max) { t_max = t; a = i; c_a = c[i]; f_a = f[i]; }
+            if (t < t_min) { t_min = t; b = i; c_b = c[i]; f_b = f[i]; }
+        }
+    }
+    vec4 span = c_a - c_b;
+    float span_sq = dot(span, span);
+    float alpha = span_sq > TINY ? clamp(dot(c[0] - c_b, span) / span_sq, 0.0, 1.0) : 0.5;
+    vec4 miss = alpha * c_a + (1.0 - alpha) * c_b - c[0];
+    float residual = sqrt(dot(miss, miss));
+    float code = float(9 * a + b);
+#if PURE_COLOURS
+    Extension ext_a = extend_extreme(c_a, c_b, p + OFFSETS[a], f_a, size);
+    Extension ext_b = extend_extreme(c_b, c_a, p + OFFSETS[b], f_b, size);
+    if (ext_a.extended || ext_b.extended) {
+        vec4 pure_span = ext_a.colour - ext_b.colour;
+        float pure_span_sq = dot(pure_span, pure_span);
+        alpha = pure_span_sq > TINY ? clamp(dot(c[0] - ext_b.colour, pure_span) / pure_span_sq, 0.0, 1.0) : 0.5;
+    }
+    if (ext_a.extended) { f_a = ext_a.filtered; fit.fixed_a = ext_a.filtered; code += 81.0; }
+    if (ext_b.extended) { f_b = ext_b.filtered; fit.fixed_b = ext_b.filtered; code += 162.0; }
+    vec4 contrast_vector = f_a - f_b;
+    edge = original_gradient * max(filtered_gradient, sqrt(dot(contrast_vector, contrast_vector)));
+#endif
+    fit.edge = edge;
+    float beta = confidence(residual, edge);
+    fit.model = vec4(alpha, beta, code, residual);
+    fit.first_iterate = beta * (alpha * f_a + (1.0 - alpha) * f_b) + (1.0 - beta) * f[0];
+    return fit;
+}

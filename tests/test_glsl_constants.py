@@ -1,0 +1,45 @@
+"""Each constant of the recovery exists once per language: the GLSL copy must equal the NumPy one."""
+
+import re
+
+import numpy as np
+import pytest
+
+from aarecovery import colour
+from aarecovery.backends.gl.glsl import read_source
+from aarecovery.spec import blend_model, pure_colours
+
+# (shader file, GLSL name) -> the value the NumPy specification uses.
+TWINS = {
+    ("pure_colours.glsl", "PALETTE_TOLERANCE"): pure_colours.PALETTE_TOLERANCE,
+    ("pure_colours.glsl", "LINE_TOLERANCE"): pure_colours.LINE_TOLERANCE,
+    ("pure_colours.glsl", "RIDGE_MARGIN"): pure_colours.RIDGE_MARGIN,
+    ("pure_colours.glsl", "EXPLAIN_TOLERANCE"): pure_colours.EXPLAIN_TOLERANCE,
+    ("pure_colours.glsl", "RANGE_TOLERANCE"): pure_colours.RANGE_TOLERANCE,
+    ("pure_colours.glsl", "END_TOLERANCE"): pure_colours.END_TOLERANCE,
+    ("blend_model.glsl", "TINY"): float(blend_model._TINY),
+    ("blend_model.glsl", "FAINT"): float(blend_model._FAINT),
+}
+
+
+def _constant(source, name):
+    match = re.search(rf"const\s+\w+\s+{name}\s*=\s*([^;]+);", source)
+    assert match, f"no constant {name}"
+    return eval(match.group(1).replace("vec3", "tuple"), {"tuple": lambda *v: v})  # numbers and a / b only
+
+
+@pytest.mark.parametrize("file, name", sorted(TWINS))
+def test_glsl_constant_equals_numpy_twin(file, name):
+    assert np.float32(_constant(read_source(file), name)) == np.float32(TWINS[file, name])
+
+
+def test_luma_weights_are_the_same_in_glsl():
+    assert _constant(read_source("colour.glsl"), "LUMA") == colour.LUMA
+
+
+def test_palette_array_holds_the_palette_size():
+    assert f"uniform vec3 palette[{pure_colours.PALETTE_SIZE}];" in read_source("pure_colours.glsl")
+
+
+def test_em_iterations_match():
+    assert f"iteration < {blend_model._EM_ITERATIONS};" in read_source("blend_model.glsl")
