@@ -63,3 +63,18 @@ def shapes(size=96, seed=0, factor=4, noise=0.0):
     image = linear_to_srgb(box_downsample(scene, factor))
     image = image + rng.normal(0, noise, image.shape).astype(np.float32)
     return to_uint8(image)
+
+
+def disc_and_bar(height=40, width=56, supersample=6):
+    """An antialiased RGBA test image: a coloured disc and a slanted bar on a soft gradient."""
+    s = supersample
+    y, x = np.mgrid[0:height * s, 0:width * s] / s
+    disc = (x - 20.3) ** 2 + (y - 18.7) ** 2 < 11.2 ** 2
+    bar = np.abs((x - 36) * 0.8 - (y - 20) * 0.6) < 3.1
+    rgb = np.empty(x.shape + (3,))
+    rgb[...] = np.stack([0.15 + 0.2 * x / width, 0.2 + 0.1 * y / height, 0.3 + 0 * x], -1)
+    rgb[disc] = (0.9, 0.75, 0.2)
+    rgb[bar] = (0.1, 0.55, 0.85)
+    alpha = np.where((x > 44) & (y > 26), 0.45, 1.0)
+    rgba = np.concatenate([rgb, alpha[..., None]], -1)
+    return rgba.reshape(height, s, width, s, 4).mean(axis=(1, 3))

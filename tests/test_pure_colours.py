@@ -110,3 +110,36 @@ def test_darkest_colour_between_thin_lines_is_pure(filter_name):
     paper = np.abs(o[panel] - 0.1).max(axis=-1) < 0.5 / 255
     assert paper.sum() > 50
     assert np.abs(recovered[panel][paper] - f[panel][paper]).max() < 2 / 255
+
+
+def test_a_smooth_gradient_keeps_f_and_a_one_ulp_change_of_o_changes_nothing(backend):
+    """A gradient stepping by 1-2 levels under a per-channel threshold: F is flat there, and
+    so must R be, on every backend and for an O that differs by one float32 ulp (what GIMP's
+    own u8-to-float conversion gives). Before the extension required more than 8 levels of
+    contrast, the gradient's quantisation noise was extended to pure colours: R showed
+    (0, 13, 0) and (20, 20, 0) on black, at pixels that swapped under a 1-ulp change."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).parent))
+    from scenes import disc_and_bar
+    eight_bit = np.round(np.clip(disc_and_bar(), 0, 1) * 255) / 255
+    original = eight_bit.astype(np.float32)
+    filtered = original.copy()
+    filtered[..., :3] = original[..., :3] >= 0.5
+    nudged = np.nextafter(original, np.float32(2)).astype(np.float32)
+    plan = aarecovery.Engine("numpy")
+    plan.set_images(original, filtered)
+    assert plan.plan().pure_colours is not None
+    results = [aarecovery.recover(o, filtered, backend=backend) for o in (original, nudged)]
+    np.testing.assert_allclose(results[0], results[1], rtol=0, atol=1 / 255)
+    # Where F and O are flat-ish (no threshold edge in F's 3x3, O's steps of 1-2 levels),
+    # R keeps F.
+    padded = np.pad(filtered, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    f_flat = np.all([np.all(padded[1 + dy:41 + dy, 1 + dx:57 + dx] == filtered, axis=-1)
+                     for dy in (-1, 0, 1) for dx in (-1, 0, 1)], axis=0)
+    padded_o = np.pad(original, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    o_smooth = np.all([np.abs(padded_o[1 + dy:41 + dy, 1 + dx:57 + dx] - original).max(axis=-1) <= 2.5 / 255
+                       for dy in (-1, 0, 1) for dx in (-1, 0, 1)], axis=0)
+    smooth = f_flat & o_smooth
+    assert smooth.sum() > 500
+    np.testing.assert_array_equal(results[0][smooth], filtered[smooth])

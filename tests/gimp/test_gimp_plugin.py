@@ -29,7 +29,9 @@ import pytest
 import aarecovery
 
 sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).parents[1]))
 import sandbox  # noqa: E402
+from scenes import disc_and_bar as scene  # noqa: E402
 
 TOLERANCE = 1 / 255 + 1e-6
 SIGMAS = {"sigma-d": 0.1, "sigma-e": 0.01, "iterations": 3}
@@ -37,21 +39,6 @@ THRESHOLD = {"filter": "threshold", "properties": "channel=value low=0.5 high=1.
 
 
 # ---- test images -----------------------------------------------------------------------------
-
-def scene(height=40, width=56, supersample=6):
-    """An antialiased RGBA test image: a coloured disc and a slanted bar on a soft gradient."""
-    s = supersample
-    y, x = np.mgrid[0:height * s, 0:width * s] / s
-    disc = (x - 20.3) ** 2 + (y - 18.7) ** 2 < 11.2 ** 2
-    bar = np.abs((x - 36) * 0.8 - (y - 20) * 0.6) < 3.1
-    rgb = np.empty(x.shape + (3,))
-    rgb[...] = np.stack([0.15 + 0.2 * x / width, 0.2 + 0.1 * y / height, 0.3 + 0 * x], -1)
-    rgb[disc] = (0.9, 0.75, 0.2)
-    rgb[bar] = (0.1, 0.55, 0.85)
-    alpha = np.where((x > 44) & (y > 26), 0.45, 1.0)
-    rgba = np.concatenate([rgb, alpha[..., None]], -1)
-    return rgba.reshape(height, s, width, s, 4).mean(axis=(1, 3))
-
 
 def threshold(image):
     """A per-channel threshold at 0.5 (colour channels only): the classic edge-damaging filter."""

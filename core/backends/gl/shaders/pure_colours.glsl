@@ -18,6 +18,7 @@ const float RIDGE_MARGIN = 0.1;
 const float EXPLAIN_TOLERANCE = 0.02;
 const float RANGE_TOLERANCE = 0.05;
 const float END_TOLERANCE = 1.0 / 255.0;
+const float MIN_CONTRAST = 8.5 / 255.0;
 
 float table_at(float key, int channel) {
     // Linear interpolation between bin centres, two fetches (no texture filtering: llvmpipe's
@@ -104,6 +105,9 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
     vec4 span = far - near;
     float len = sqrt(dot(span, span));
     if (!(len > 1e-6)) return result;
+    // Extremes within an 8-bit gradient's noise of each other are not a thin feature.
+    vec3 steps = abs(encoded_of(far) - encoded_of(near));
+    if (!(max(max(max(steps.r, steps.g), steps.b), abs(span.a)) >= MIN_CONTRAST)) return result;
     if (q.x <= 0 || q.y <= 0 || q.x >= size.x - 1 || q.y >= size.y - 1) return result;
     for (int i = 0; i < palette_size; ++i) {
         vec3 miss = far.rgb - palette[i] * far.a;
