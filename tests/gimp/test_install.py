@@ -243,7 +243,9 @@ def test_zip_has_executable_plugin(tmp_path):
         info = zf.getinfo("aarecovery-gimp/aarecovery-gimp.py")
         assert (info.external_attr >> 16) & 0o111, "the script must unpack executable"
         assert zf.read(info) == inst.plugin_source().read_bytes()
-        assert json.loads(zf.read("aarecovery-gimp/config.json")) == {"python": ""}
+        config = json.loads(zf.read("aarecovery-gimp/config.json"))
+        assert config == {"python": "", "aarecovery_version": aarecovery.__version__}
+        assert "aarecovery-gimp/README.txt" in zf.namelist()
 
 
 def test_worker_mode_matches_recover(tmp_path):
