@@ -69,7 +69,8 @@ def core_files():
     left_out = []
     for name in ("aarecovery.viewer", "aarecovery.gimp"):
         spec = importlib.util.find_spec(name)
-        left_out += [Path(p).resolve() for p in (spec.submodule_search_locations or [])] if spec else []
+        if spec is not None:
+            left_out += [Path(p).resolve() for p in spec.submodule_search_locations or []]
     for root in map(Path, aarecovery.__path__):
         for path in sorted(root.rglob("*")):
             if (not path.is_file() or "__pycache__" in path.parts or path.suffix == ".pyc"

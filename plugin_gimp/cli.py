@@ -49,7 +49,7 @@ def run(args):
     """Carry out ``args.action``; return the exit status. Errors are one line on stderr."""
     try:
         return {"install": _install, "uninstall": _uninstall, "status": _status}[args.action](args)
-    except InstallError as error:
+    except (InstallError, OSError) as error:   # python -m aarecovery.gimp has no other handler
         print(f"aarecovery: error: {error}", file=sys.stderr)
         return 1
 
@@ -99,7 +99,8 @@ def _uninstall(args):
     from . import install as inst
     profile = _profile(args)
     folder = profile.plugins_dir / inst.PLUGIN_NAME
-    print(f"removed {folder}" if inst.uninstall(profile.plugins_dir) else f"not installed: {folder}")
+    removed = inst.uninstall(profile.plugins_dir)
+    print(f"removed {folder}" if removed else f"not installed: {folder}")
     return 0
 
 

@@ -184,6 +184,14 @@ def test_failed_bundle_leaves_the_earlier_install(tmp_path, monkeypatch, capsys)
     assert (plugins / "aarecovery-gimp" / "config.json").read_text() == config
 
 
+def test_unwritable_plugins_folder_is_one_line(tmp_path, capsys):
+    (tmp_path / "file").write_text("")
+    from aarecovery.gimp.__main__ import main as gimp_main
+    assert gimp_main(["install", "--plugins-dir", str(tmp_path / "file" / "plug-ins")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("aarecovery: error: ") and err.count("\n") == 1, err
+
+
 def test_flatpak_install_bundles_and_needs_flatpak_to_ask(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("HOME", str(tmp_path))
     monkeypatch.setenv("PATH", str(Path(sys.executable).parent))       # no flatpak command
