@@ -14,8 +14,10 @@ Pixels are read and written as 32-bit float through GEGL in the image's own tone
 8- or 16-bit layer is quantised once, on the final write. The result goes through the shadow
 buffer, so an active selection limits the change and a feathered one blends.
 
-The core runs in GIMP's Python when ``import aarecovery`` works there (Linux distributions).
-Otherwise this same file runs as a worker under a configured Python that has aarecovery:
+The core runs in GIMP's Python when ``import aarecovery`` works there: from the bundle that
+``aarecovery gimp install --bundle`` puts into ``site-packages`` next to this file (when it was
+made for this Python), or from GIMP's own paths (a Linux distribution's package). Otherwise
+this same file runs as a worker under a configured Python that has aarecovery:
 ``python aarecovery-gimp.py --worker O.npy F.npy R.npy PARAMS.json``, the pixels travelling
 as ``.npy`` files written without NumPy (GIMP's bundled Python may lack it). The Python is,
 in order: the procedure's ``python`` argument, the environment variable ``AARECOVERY_PYTHON``,
@@ -36,6 +38,17 @@ PROC_FILTER = "plug-in-aarecovery-apply-filter"
 PROC_LAYER = "plug-in-aarecovery-from-layer"
 HERE = os.path.dirname(os.path.abspath(__file__))
 CONFIG_FILE = os.path.join(HERE, "config.json")
+BUNDLE_DIR = os.path.join(HERE, "site-packages")
+
+
+def read_config():
+    """``config.json`` next to this file as a dict; empty when it is missing or unreadable."""
+    try:
+        with open(CONFIG_FILE, encoding="utf-8") as fh:
+            data = json.load(fh)
+    except (OSError, ValueError):
+        return {}
+    return data if isinstance(data, dict) else {}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -64,6 +77,14 @@ def recover_arrays(original, filtered, params):
     return np.ascontiguousarray(result, dtype=np.float32), engine.backend, messages
 
 
+def package_folders():
+    """The folders aarecovery and NumPy were imported from; each run reports them back."""
+    import numpy
+    import aarecovery
+    return {"aarecovery": os.path.dirname(os.path.abspath(aarecovery.__file__)),
+            "numpy": os.path.dirname(os.path.abspath(numpy.__file__))}
+
+
 def worker_main(argv):
     """``--worker O.npy F.npy R.npy PARAMS.json``: the out-of-process side; prints one JSON line."""
     import numpy as np
@@ -82,7 +103,7 @@ def worker_main(argv):
         print(json.dumps({"error": str(error)}))
         return 0
     np.save(r_path, result)
-    print(json.dumps({"backend": backend, "messages": messages}))
+    print(json.dumps({"backend": backend, "messages": messages, "folders": package_folders()}))
     return 0
 
 
@@ -92,6 +113,41 @@ if __name__ == "__main__" and len(sys.argv) > 1 and sys.argv[1] == "--worker":
 
 # ---------------------------------------------------------------------------------------------
 # The GIMP side.
+
+def python_platform():
+    """This Python's platform in the form the bundle records: sysconfig's, less macOS's version.
+
+    The version is the oldest macOS the Python was built for; wheels for an older one load too.
+    """
+    import re
+    import sysconfig
+    return re.sub(r"^macosx-[0-9.]+-", "macosx-", sysconfig.get_platform())
+
+
+def use_bundle():
+    """Put the bundled packages first on ``sys.path`` if they were made for this Python.
+
+    First, so that they shadow a NumPy or moderngl that GIMP's Python has from the system
+    (Debian's python3-numpy): the bundled core was installed with the bundled ones. Returns a
+    sentence saying why the bundle is not used, or None (it is used, or there is none).
+    """
+    bundle = read_config().get("bundle")
+    if not bundle:
+        return None
+    if not os.path.isdir(BUNDLE_DIR):
+        return (f"the bundle folder {BUNDLE_DIR} is missing; run 'aarecovery gimp install "
+                "--bundle' again")
+    mine = ("%d.%d" % sys.version_info[:2], python_platform())
+    made_for = (bundle.get("python"), bundle.get("platform"))
+    if sys.implementation.name != "cpython" or made_for != mine:
+        return (f"the packages bundled in {BUNDLE_DIR} are for CPython {made_for[0]} on "
+                f"{made_for[1]}, but GIMP runs {sys.implementation.name} {mine[0]} on {mine[1]}; "
+                "run 'aarecovery gimp install --bundle' again")
+    sys.path.insert(0, BUNDLE_DIR)
+    return None
+
+
+BUNDLE_NOTE = use_bundle()
 
 import gi  # noqa: E402  (the worker above must not need gi)
 
@@ -216,15 +272,15 @@ def configured_python(config):
         return python
     if os.environ.get("AARECOVERY_PYTHON"):
         return os.environ["AARECOVERY_PYTHON"]
-    try:
-        with open(CONFIG_FILE, encoding="utf-8") as fh:
-            return json.load(fh).get("python") or None
-    except (OSError, ValueError):
-        return None
+    return read_config().get("python") or None
 
 
 def run_core(o_data, o_shape, f_data, f_shape, params, config):
-    """Recover; return ``(bytes, backend, where, messages)``; `where` is the runner used."""
+    """Recover; return ``(bytes, backend, where, messages, folders)``.
+
+    `where` is the runner used; `folders` says where aarecovery and NumPy came from.
+    """
+    notes = [BUNDLE_NOTE] if BUNDLE_NOTE else []      # the status bar says why it was skipped
     try:
         import numpy as np
         import aarecovery
@@ -237,16 +293,22 @@ def run_core(o_data, o_shape, f_data, f_shape, params, config):
             result, backend, messages = recover_arrays(original, filtered, params)
         except aarecovery.InputError as error:
             raise PluginError(str(error)) from None
-        return result.tobytes(), backend, "in-process", messages
+        return result.tobytes(), backend, "in-process", notes + messages, package_folders()
 
     python = configured_python(config)
+    if BUNDLE_DIR in sys.path:              # made for this Python, and yet it does not import
+        notes.append(f"the packages bundled in {BUNDLE_DIR} do not import in GIMP's Python "
+                     f"({import_error}); run 'aarecovery gimp install --bundle' again")
     if not python:
+        if BUNDLE_DIR in sys.path:
+            raise PluginError(notes[-1])
         raise PluginError(
             f"GIMP's Python ({sys.executable}, {sys.version.split()[0]}) cannot import "
-            f"aarecovery ({import_error}) and no Python with aarecovery is configured. Either "
-            "run 'aarecovery gimp install' from a Python that has aarecovery, set the "
-            "environment variable AARECOVERY_PYTHON, or enter that Python in the plug-in's "
-            "'Python with aarecovery' field.")
+            f"aarecovery ({import_error}) and no Python with aarecovery is configured"
+            + (f" ({BUNDLE_NOTE})" if BUNDLE_NOTE else "") + ". Either run 'aarecovery gimp "
+            "install --bundle', or run 'aarecovery gimp install' from a Python that has "
+            "aarecovery, set the environment variable AARECOVERY_PYTHON, or enter that Python "
+            "in the plug-in's 'Python with aarecovery' field.")
     with tempfile.TemporaryDirectory(prefix="aarecovery-gimp-") as tmp:
         paths = [os.path.join(tmp, n) for n in ("o.npy", "f.npy", "r.npy", "params.json")]
         write_npy(paths[0], o_data, o_shape)
@@ -271,7 +333,8 @@ def run_core(o_data, o_shape, f_data, f_shape, params, config):
         if "error" in reply:
             raise PluginError(reply["error"])
         nbytes = f_shape[0] * f_shape[1] * f_shape[2] * 4
-        return read_npy(paths[2], nbytes), reply["backend"], "subprocess", reply["messages"]
+        return (read_npy(paths[2], nbytes), reply["backend"], "subprocess",
+                notes + reply["messages"], reply["folders"])
 
 
 # ---- filters ---------------------------------------------------------------------------------
@@ -499,12 +562,12 @@ def grab(image, procedure_name, layer, config):
 
 
 def recover_layer(procedure_name, image, layer, config):
-    """Do the whole job on `layer` inside one undo group; return (backend, where)."""
+    """Do the whole job on `layer` inside one undo group; return (backend, where, folders)."""
     Gimp.progress_init("Antialiasing recovery")
     image.undo_group_start()
     try:
         fmt, o, o_shape, f, f_shape, params = grab(image, procedure_name, layer, config)
-        data, backend, where, messages = run_core(o, o_shape, f, f_shape, params, config)
+        data, backend, where, messages, folders = run_core(o, o_shape, f, f_shape, params, config)
         write_pixels(layer, fmt, data)
         if messages:
             # The GL fallback note goes to the status bar, not a dialog: the result is right.
@@ -512,7 +575,7 @@ def recover_layer(procedure_name, image, layer, config):
     finally:
         image.undo_group_end()
         Gimp.progress_end()
-    return backend, where
+    return backend, where, folders
 
 
 # ---- dialog ----------------------------------------------------------------------------------
@@ -561,7 +624,7 @@ def show_dialog(procedure, config, image, layer):
                 config.set_property("original-layer", layer_below(image, layer))
             try:
                 fmt, o, o_shape, f, f_shape, params = grab(image, procedure.get_name(), layer, config)
-                data, backend, _, _ = run_core(o, o_shape, f, f_shape, params, config)
+                data = run_core(o, o_shape, f, f_shape, params, config)[0]
             except PluginError as error:
                 Gimp.message(str(error))
                 return
@@ -592,7 +655,7 @@ def run(procedure, run_mode, image, drawables, config, data):
         if run_mode == Gimp.RunMode.INTERACTIVE:
             if not show_dialog(procedure, config, image, layer):
                 return procedure.new_return_values(Gimp.PDBStatusType.CANCEL, GLib.Error())
-        backend, where = recover_layer(procedure.get_name(), image, layer, config)
+        backend, where, folders = recover_layer(procedure.get_name(), image, layer, config)
     except PluginError as error:
         return procedure.new_return_values(Gimp.PDBStatusType.EXECUTION_ERROR, GLib.Error(str(error)))
     except Exception as error:            # a bug: still a message, never a silent failure
@@ -603,7 +666,8 @@ def run(procedure, run_mode, image, drawables, config, data):
             GLib.Error(f"aarecovery plug-in failed unexpectedly: {type(error).__name__}: {error}"))
     Gimp.displays_flush()
     values = procedure.new_return_values(Gimp.PDBStatusType.SUCCESS, GLib.Error())
-    for index, value in ((1, backend), (2, where)):
+    for index, value in ((1, backend), (2, where), (3, folders["aarecovery"]),
+                         (4, folders["numpy"])):
         values.remove(index)
         values.insert(index, GObject.Value(GObject.TYPE_STRING, value))
     return values
@@ -670,6 +734,10 @@ class AntialiasingRecovery(Gimp.PlugIn):
                                       "", flags)
         procedure.add_string_return_value("backend", "Backend", "gl or numpy", "", flags)
         procedure.add_string_return_value("runner", "Runner", "in-process or subprocess", "", flags)
+        procedure.add_string_return_value("aarecovery-path", "aarecovery path",
+                                          "The folder the core was imported from", "", flags)
+        procedure.add_string_return_value("numpy-path", "NumPy path",
+                                          "The folder NumPy was imported from", "", flags)
         return procedure
 
 

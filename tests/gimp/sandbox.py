@@ -8,7 +8,8 @@ the root twice, from one wheel built from a copy of the working tree:
     own Python imports the core.
 ``/opt/aarecovery/venv``
     a venv over Debian's numpy/moderngl (``--system-site-packages``) with aarecovery in it:
-    the "configured Python" of the out-of-process runs, where GIMP's Python cannot import it.
+    the "configured Python" of the out-of-process runs, where GIMP's Python cannot import it,
+    and the Python that installs the bundled plug-in (its pip fetches the wheels: ``pip_env``).
 """
 
 import os
@@ -24,6 +25,19 @@ BUILD_HINT = f"sudo {SANDBOX_SCRIPT.relative_to(CHECKOUT)}"
 SITE = "/opt/aarecovery/site"
 VENV = "/opt/aarecovery/venv"
 VENV_PYTHON = f"{VENV}/bin/python"
+# pip inside the root trusts the host's CA bundle (a TLS proxy may sit in between).
+PIP_ENV = {"PIP_CERT": "/etc/aarecovery/host-ca.crt"}
+# The bundle's wheels, kept between runs inside the cached root: later runs fetch only what is
+# new. (pip's own HTTP cache is no help where an index serves its files as uncacheable.)
+WHEEL_CACHE = "/var/cache/aarecovery/gimp-bundle-wheels"
+# The host's index and proxy settings, passed through where set (a CI mirror, say).
+PIP_HOST_SETTINGS = ("PIP_INDEX_URL", "HTTPS_PROXY", "https_proxy", "HTTP_PROXY", "http_proxy",
+                     "NO_PROXY", "no_proxy")
+
+
+def pip_env():
+    """The environment for running pip inside the root with this machine's registry access."""
+    return {**PIP_ENV, **{k: os.environ[k] for k in PIP_HOST_SETTINGS if os.environ.get(k)}}
 
 
 def missing_piece():

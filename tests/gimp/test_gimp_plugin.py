@@ -4,12 +4,17 @@ Build the root once with ``sudo packaging/gimp-sandbox.sh`` (packaging/test.sh d
 as root). Without the root these tests skip with the command to build it, except under CI
 (environment variable CI set), where they fail: CI must exercise GIMP.
 
-Two batch runs share one throwaway GIMP profile into which ``python -m aarecovery.gimp
+Three batch runs share one throwaway GIMP profile into which ``python -m aarecovery.gimp
 install`` (run inside the root, from the venv) installs the plug-in:
 
 * in-process: ``PYTHONPATH`` lets GIMP's Python import aarecovery;
 * out-of-process: GIMP's Python cannot import it, so the plug-in runs the core in the Python
-  that the installer recorded (the venv).
+  that the installer recorded (the venv);
+* no-gl: in-process where no OpenGL context can be made.
+
+A fourth run uses a profile installed with ``--bundle``: GIMP's Python imports the core, NumPy
+and moderngl from the plug-in's own folder, with no aarecovery anywhere else it can see. Its
+wheels come from the package index through pip, as in CI.
 
 Every exported result is compared with ``aarecovery.recover`` on the pixels GIMP exported as
 its input; they must agree within 1/255.
@@ -21,6 +26,7 @@ import shutil
 import sys
 import time
 import uuid
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -187,13 +193,15 @@ def build_cases(workdir, inside):
 OUT_OF_PROCESS = ("layer-rgb8", "layer-rgb8-feathered-selection", "filter-threshold-rgba8",
                   "filter-unsharp-float", "error-offset-layer")
 NO_GL = ("layer-rgb8", "filter-threshold-rgba8")
+BUNDLED = ("layer-rgb8", "layer-greya8", "layer-rgba-float-linear", "layer-rgb8-feathered-selection",
+           "filter-threshold-rgba8", "filter-unsharp-float", "error-offset-layer")
 
 
 # ---- running GIMP ----------------------------------------------------------------------------
 
 @pytest.fixture(scope="session")
-def gimp_runs():
-    """Install the checkout into the root, run both batch runs; yield their results."""
+def installed_root():
+    """The trixie root with the checkout installed in it (site dir and venv), mounted."""
     missing = sandbox.missing_piece()
     if missing:
         message = (f"GIMP 3 plug-in tests cannot run: {missing}. Build the sandbox with: "
@@ -202,50 +210,97 @@ def gimp_runs():
             pytest.fail(message)
         print(f"\n*** SKIPPING THE GIMP TESTS: {message} ***\n", file=sys.stderr)
         pytest.skip(message)
-
-    timings = {}
     with sandbox.Sandbox() as box:
-        timings["install"] = box.install_checkout()
-        inside = f"/tmp/aarecovery-test-{uuid.uuid4().hex[:8]}"
-        workdir = box.host_path(inside)
-        workdir.mkdir(parents=True)
-        try:
-            profile = f"{inside}/profile"
-            box.run([sandbox.VENV_PYTHON, "-m", "aarecovery.gimp", "install"],
-                    env={"GIMP3_DIRECTORY": profile})
-            shutil.copy(Path(__file__).with_name("driver.py"), workdir / "driver.py")
-            cases = build_cases(workdir, inside)
-            runs = {}
-            for mode, env, names in (
-                    ("in-process", {"PYTHONPATH": sandbox.SITE}, None),
-                    ("subprocess", {}, OUT_OF_PROCESS),
-                    # No EGL vendor and no display: GL cannot start inside GIMP.
-                    ("no-gl", {"PYTHONPATH": sandbox.SITE, "__EGL_VENDOR_LIBRARY_FILENAMES": "/nonexistent.json"},
-                     NO_GL)):
-                run_dir = workdir / mode
-                run_dir.mkdir()
-                chosen = [c for c in cases if names is None or c["name"] in names]
-                (run_dir / "cases.json").write_text(json.dumps(chosen))
-                start = time.monotonic()
-                proc = box.gimp_batch(f"{inside}/driver.py", env={
-                    "GIMP3_DIRECTORY": profile, "AARECOVERY_CASES": f"{inside}/{mode}/cases.json",
-                    **env})
-                timings[mode] = time.monotonic() - start
-                results_file = run_dir / "results.json"
-                if not results_file.exists():
-                    pytest.fail(f"the {mode} GIMP batch run wrote no results (exit "
-                                f"{proc.returncode}):\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
-                runs[mode] = {"exit": proc.returncode, "log": proc.stdout + proc.stderr,
-                              "dir": run_dir, "cases": {c["name"]: c for c in chosen},
-                              "results": {r["name"]: r for r in json.loads(results_file.read_text())}}
-            print("\nGIMP test timings (s): " +
-                  ", ".join(f"{k} {v:.1f}" for k, v in timings.items()), file=sys.stderr)
-            yield runs
-        finally:
-            if os.environ.get("AARECOVERY_KEEP_GIMP_TEST"):     # for debugging a failure
-                print(f"kept the GIMP test files in {workdir}", file=sys.stderr)
-            else:
-                shutil.rmtree(workdir, ignore_errors=True)
+        seconds = box.install_checkout()
+        print(f"\nGIMP tests: checkout installed into the root in {seconds:.1f} s", file=sys.stderr)
+        yield box
+
+
+@contextmanager
+def scratch_folder(box):
+    """A throwaway folder inside the root with the driver in it: ``(path inside, host path)``."""
+    inside = f"/tmp/aarecovery-test-{uuid.uuid4().hex[:8]}"
+    workdir = box.host_path(inside)
+    workdir.mkdir(parents=True)
+    try:
+        shutil.copy(Path(__file__).with_name("driver.py"), workdir / "driver.py")
+        yield inside, workdir
+    finally:
+        if os.environ.get("AARECOVERY_KEEP_GIMP_TEST"):     # for debugging a failure
+            print(f"kept the GIMP test files in {workdir}", file=sys.stderr)
+        else:
+            shutil.rmtree(workdir, ignore_errors=True)
+
+
+def batch_run(box, inside, mode, profile, env, cases):
+    """Run the driver on `cases` in GIMP with the plug-ins of `profile`; return the run."""
+    run_dir = box.host_path(inside) / mode
+    run_dir.mkdir()
+    (run_dir / "cases.json").write_text(json.dumps(cases))
+    start = time.monotonic()
+    proc = box.gimp_batch(f"{inside}/driver.py", env={
+        "GIMP3_DIRECTORY": profile, "AARECOVERY_CASES": f"{inside}/{mode}/cases.json", **env})
+    seconds = time.monotonic() - start
+    results_file = run_dir / "results.json"
+    if not results_file.exists():
+        pytest.fail(f"the {mode} GIMP batch run wrote no results (exit "
+                    f"{proc.returncode}):\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
+    return {"exit": proc.returncode, "log": proc.stdout + proc.stderr, "dir": run_dir,
+            "seconds": seconds, "cases": {c["name"]: c for c in cases},
+            "results": {r["name"]: r for r in json.loads(results_file.read_text())}}
+
+
+@pytest.fixture(scope="session")
+def gimp_runs(installed_root):
+    """The plug-in installed as a pip user has it; the three batch runs' results."""
+    box = installed_root
+    with scratch_folder(box) as (inside, workdir):
+        profile = f"{inside}/profile"
+        box.run([sandbox.VENV_PYTHON, "-m", "aarecovery.gimp", "install"],
+                env={"GIMP3_DIRECTORY": profile})
+        cases = build_cases(workdir, inside)
+        runs = {}
+        for mode, env, names in (
+                ("in-process", {"PYTHONPATH": sandbox.SITE}, None),
+                ("subprocess", {}, OUT_OF_PROCESS),
+                # No EGL vendor and no display: GL cannot start inside GIMP.
+                ("no-gl", {"PYTHONPATH": sandbox.SITE, "__EGL_VENDOR_LIBRARY_FILENAMES": "/nonexistent.json"},
+                 NO_GL)):
+            chosen = [c for c in cases if names is None or c["name"] in names]
+            runs[mode] = batch_run(box, inside, mode, profile, env, chosen)
+        print("\nGIMP test timings (s): " +
+              ", ".join(f"{k} {v['seconds']:.1f}" for k, v in runs.items()), file=sys.stderr)
+        yield runs
+
+
+@pytest.fixture(scope="session")
+def bundled_run(installed_root):
+    """The plug-in installed with ``--bundle``, which GIMP's Python must use: no other core.
+
+    The installer asks GIMP's Python (the root's /usr/bin/python3) for its version and
+    platform, and pip downloads the wheels through this machine's registry access into a
+    wheel folder kept inside the root. Debian's python3-numpy and python3-moderngl stay
+    installed: the bundle has to shadow them.
+    """
+    box = installed_root
+    probe = box.run(["python3", "-c", "import aarecovery"], check=False)
+    assert probe.returncode != 0, "aarecovery is importable by the root's Python: the test is void"
+    with scratch_folder(box) as (inside, workdir):
+        profile = f"{inside}/profile-bundled"
+        start = time.monotonic()
+        installed = box.run([sandbox.VENV_PYTHON, "-m", "aarecovery.gimp", "install", "--bundle",
+                             "--wheel-dir", sandbox.WHEEL_CACHE],
+                            env={"GIMP3_DIRECTORY": profile, **sandbox.pip_env()}, timeout=900)
+        install_seconds = time.monotonic() - start
+        status = box.run([sandbox.VENV_PYTHON, "-m", "aarecovery.gimp", "status"],
+                         env={"GIMP3_DIRECTORY": profile}, check=False)
+        cases = [c for c in build_cases(workdir, inside) if c["name"] in BUNDLED]
+        run = batch_run(box, inside, "bundled", profile, {}, cases)
+        run.update(install=installed.stdout, status=status,
+                   site=f"{profile}/plug-ins/aarecovery-gimp/site-packages")
+        print(f"\nGIMP bundled run (s): install {install_seconds:.1f}, batch {run['seconds']:.1f}"
+              f"\n{installed.stdout.strip()}", file=sys.stderr)
+        yield run
 
 
 CASE_NAMES = [
@@ -351,3 +406,29 @@ def test_dialog_opens_under_xvfb(gimp_runs, tmp_path):
     from PIL import Image
     with Image.open(out) as shot:
         assert shot.width > 200 and shot.height > 200, shot.size
+
+
+def test_bundle_is_made_for_the_python_gimp_runs(bundled_run):
+    # Asked, not assumed: the root's GIMP runs #!/usr/bin/env python3 with /usr/bin/python3.
+    assert "for CPython 3.13 on linux-x86_64 (/usr/bin/python3)" in bundled_run["install"]
+    status = bundled_run["status"]
+    assert status.returncode == 0, status.stdout + status.stderr
+    assert "GIMP's Python:  CPython 3.13 on linux-x86_64" in status.stdout
+    assert "(up to date)" in status.stdout and "numpy" in status.stdout
+
+
+def test_bundled_batch_run_exits_cleanly(bundled_run):
+    assert bundled_run["exit"] == 0, bundled_run["log"][-4000:]
+    assert "Traceback" not in bundled_run["log"], bundled_run["log"]
+    error = bundled_run["results"]["error-offset-layer"]
+    assert error["status"] == "execution-error" and "same size and position" in error["message"]
+
+
+@pytest.mark.parametrize("name", [n for n in BUNDLED if n in CASE_NAMES])
+def test_bundled_plugin_gives_the_pixels_of_recover(bundled_run, name):
+    result = check_case(bundled_run, name)
+    assert result["runner"] == "in-process", result
+    # The bundle's copies, not Debian's /usr/lib/python3/dist-packages/numpy.
+    assert result["aarecovery_path"] == f"{bundled_run['site']}/aarecovery", result
+    assert result["numpy_path"] == f"{bundled_run['site']}/numpy", result
+    assert result["backend"] == "gl", result
