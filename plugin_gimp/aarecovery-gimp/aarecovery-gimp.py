@@ -185,6 +185,20 @@ FILTERS = {
     "gegl": ("gegl", None, "Other GEGL operation (by name)", ""),
 }
 BACKENDS = ("auto", "gl", "numpy")
+# The recovery parameters as the core declares them in aarecovery.PARAMETERS. GIMP's Python may
+# not be able to import the core, so they are repeated here; tests/gimp/test_install.py checks
+# that they match. (GIMP argument name, dialog label, kind, minimum, maximum, default, help.)
+RECOVERY_ARGUMENTS = (
+    ("sigma-d", "Sigma _d", "float", 0.001, 1.0, 0.1,
+     "colour-line distance scale: neighbours further than 3 sigma_d from the colour line are "
+     "not blend candidates, and a poor fit lowers the confidence; larger accepts noisier "
+     "colour lines"),
+    ("sigma-e", "Sigma _e", "float", 0.0001, 1.0, 0.01,
+     "edge-strength scale: an edge of strength e gets confidence 1 - exp(-(e/sigma_e)^2); "
+     "smaller repairs weaker edges"),
+    ("iterations", "_Iterations", "int", 0, 64, 3,
+     "Jacobi iterations of the recovery solve; 0 returns the filtered image"),
+)
 
 
 # ---- pixels ----------------------------------------------------------------------------------
@@ -522,9 +536,8 @@ def check_aligned(original, filtered):
 
 
 def core_params(config, linear, clip_filtered):
-    return {"sigma_d": config.get_property("sigma-d"), "sigma_e": config.get_property("sigma-e"),
-            "iterations": config.get_property("iterations"),
-            "backend": config.get_property("backend"), "linear": linear,
+    recovery = {name.replace("-", "_"): config.get_property(name) for name, *_ in RECOVERY_ARGUMENTS}
+    return {**recovery, "backend": config.get_property("backend"), "linear": linear,
             "clip_filtered": clip_filtered}
 
 
@@ -584,7 +597,7 @@ def show_dialog(procedure, config, image, layer):
     """The ProcedureDialog with an on-canvas preview toggle; returns True on OK."""
     GimpUi.init(PLUGIN)
     dialog = GimpUi.ProcedureDialog.new(procedure, config, procedure.get_menu_label())
-    names = ["sigma-d", "sigma-e", "iterations", "backend", "python"]
+    names = [name for name, *_ in RECOVERY_ARGUMENTS] + ["backend", "python"]
     if procedure.get_name() == PROC_FILTER:
         names = ["filter", "operation", "properties"] + names
 
@@ -718,11 +731,9 @@ class AntialiasingRecovery(Gimp.PlugIn):
                                          "The layer before the filter (none: the layer below)",
                                          True, flags)
         procedure.add_menu_path("<Image>/Filters/Enhance")        # after the label: GIMP needs it
-        procedure.add_double_argument("sigma-d", "Sigma _d", "Colour-line distance scale: larger "
-                                      "accepts noisier colour lines", 0.001, 1.0, 0.1, flags)
-        procedure.add_double_argument("sigma-e", "Sigma _e", "Edge-strength scale: smaller "
-                                      "repairs weaker edges", 0.0001, 1.0, 0.01, flags)
-        procedure.add_int_argument("iterations", "_Iterations", "Jacobi iterations", 0, 64, 3, flags)
+        for name, label, kind, minimum, maximum, default, blurb in RECOVERY_ARGUMENTS:
+            add = procedure.add_int_argument if kind == "int" else procedure.add_double_argument
+            add(name, label, blurb[0].upper() + blurb[1:], minimum, maximum, default, flags)
         backends = Gimp.Choice.new()
         for index, key in enumerate(BACKENDS):
             backends.add(key, index, key, "")

@@ -293,3 +293,18 @@ def test_help(argv, capsys):
         main(argv)
     assert stop.value.code == 0
     assert "install" in capsys.readouterr().out
+
+
+def test_plugin_dialog_repeats_the_core_parameters_exactly():
+    """The plug-in script runs in GIMP's Python, which may not import the core, so it repeats
+    every recovery parameter; each must equal aarecovery.PARAMETERS (name, kind, range,
+    default, help)."""
+    import ast
+    tree = ast.parse(inst.plugin_source().read_text(encoding="utf-8"))
+    table = next(node.value for node in tree.body if isinstance(node, ast.Assign)
+                 and any(getattr(target, "id", None) == "RECOVERY_ARGUMENTS" for target in node.targets))
+    rows = ast.literal_eval(table)
+    assert [row[0] for row in rows] == [spec.name.replace("_", "-") for spec in aarecovery.PARAMETERS.values()]
+    for (_, _, kind, minimum, maximum, default, blurb), spec in zip(rows, aarecovery.PARAMETERS.values()):
+        assert (kind, minimum, maximum, default, blurb) == (spec.kind.__name__, spec.minimum, spec.maximum,
+                                                            spec.default, spec.help)
