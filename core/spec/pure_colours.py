@@ -67,9 +67,12 @@ PALETTE_SIZE = 32
 # An extreme colour within this distance (working space) of a palette colour is pure.
 PALETTE_TOLERANCE = 0.03
 # Ridge test: neighbours count when they lie within this distance of the colour line, and
-# are "less extreme" when lower by more than this share of the line's span.
+# are "less extreme" when lower by more than this share of the line's span. A tenth, made
+# 0.1001: synthetic scenes have exact coverages, so a neighbour can sit exactly 10 % below
+# the extreme, and with a margin of exactly 0.1 rounding decided the test, differently in
+# GL and NumPy (beta differed by 0.08-0.22 on shapes under a cube curve). No suite case moved.
 LINE_TOLERANCE = 0.05
-RIDGE_MARGIN = 0.1
+RIDGE_MARGIN = 0.1001
 # The table must reproduce F at the observed extreme within this (working space).
 EXPLAIN_TOLERANCE = 0.02
 #: An extreme is tested only when it differs from the other extreme by more than 8 levels of

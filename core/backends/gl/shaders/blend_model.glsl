@@ -108,6 +108,12 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
             if (t < t_min) { t_min = t; b = i; c_b = c[i]; f_b = f[i]; }
         }
     }
+    // The direction's sign is arbitrary: name the extremes in neighbour order (see the twin).
+    if (a > b) {
+        int first = b; b = a; a = first;
+        vec4 colour = c_b; c_b = c_a; c_a = colour;
+        vec4 filtered = f_b; f_b = f_a; f_a = filtered;
+    }
     vec4 span = c_a - c_b;
     float span_sq = dot(span, span);
     float alpha = span_sq > TINY ? clamp(dot(c[0] - c_b, span) / span_sq, 0.0, 1.0) : 0.5;

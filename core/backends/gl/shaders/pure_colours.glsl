@@ -14,7 +14,7 @@ uniform int clamp_ends;            // 1: an extreme at an end of the range reads
 
 const float PALETTE_TOLERANCE = 0.03;
 const float LINE_TOLERANCE = 0.05;
-const float RIDGE_MARGIN = 0.1;
+const float RIDGE_MARGIN = 0.1001;
 const float EXPLAIN_TOLERANCE = 0.02;
 const float RANGE_TOLERANCE = 0.05;
 const float END_TOLERANCE = 1.0 / 255.0;
