@@ -47,7 +47,10 @@ def _group_lines(results, key, title, methods, png_only=True):
     lines = ["", f"== per {title}: mean edge-band error reduction over {which} where F has an error (n) | "
                  f"R worse than F by > {MAX_LOSS_DB} dB, worst loss (every case)",
              f"{title:26s} {'n':>4s} " + " ".join(f"{m:>7s}" for m in reduced) + " | losses  worst dB"]
-    for name in dict.fromkeys(key(r) for r in results):
+    names = dict.fromkeys(key(r) for r in results)
+    if not png_only:  # sources: PNG, then JPEG by quality
+        names = sorted(names, key=lambda name: (name != "png", name))
+    for name in names:
         mine = [r for r in results if key(r) == name]
         means, count = mean_reductions([r for r in mine if r.quality is None or not png_only])
         losses = [r.psnr_band["F"] - r.psnr_band["R"] for r in mine]
