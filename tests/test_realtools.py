@@ -203,6 +203,17 @@ def test_small_suite_end_to_end_with_each_tool():
     assert "HELD-OUT" in format_realtools(results, half="heldout")
 
 
+def test_missing_tools_are_reported_loudly():
+    from aarecovery.lab.peers import PEERS
+    from aarecovery.lab.realeval import RealCaseResult
+    result = RealCaseResult("maps", "srgb", "gegl-threshold", "drawing", 0.5, psnr={"F": 10, "R": 12},
+                            ssim={"F": 0.5, "R": 0.6}, psnr_band={"F": 10, "R": 12}, ssim_band={"F": 0.5, "R": 0.6},
+                            reduction={"R": 0.37}, tool="gegl", group="threshold", half="tune")
+    table = format_realtools([result], missing_tools=list(TOOLS.values()), missing_peers=PEERS)
+    assert table.count("NOT installed") == len(TOOLS) + len(PEERS)
+    assert "imagemagick" in table and "gmic" in table and "maps/srgb/gegl-threshold/png" in table
+
+
 def test_eval_command_runs_the_realtools_suite(capsys):
     from aarecovery.cli import main
     for name in ("gegl",):

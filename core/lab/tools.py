@@ -217,8 +217,8 @@ class Tool:
 TOOLS = {t.name: t for t in (
     Tool("gegl", "GEGL (GIMP's operations)", ("gegl",), "gegl", _gegl_batch),
     Tool("gmic", "G'MIC", ("gmic",), "gmic", _gmic_batch),
-    # On some machines `convert` is a placeholder until ImageMagick is installed: only a
-    # command whose -version names ImageMagick counts.
+    # `convert` is also the name of other programs (Windows' disk converter, placeholders
+    # on some machines): only a command whose -version names ImageMagick counts.
     Tool("imagemagick", "ImageMagick", ("magick", "convert"), "imagemagick", _imagemagick_batch, "ImageMagick"),
 )}
 
