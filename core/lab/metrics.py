@@ -9,7 +9,7 @@ import numpy as np
 from ..filters.spatial import gaussian_filter
 from ..spec.sobel import image_gradients
 
-__all__ = ["mse", "psnr", "ssim", "ssim_map", "edge_band", "error_reduction"]
+__all__ = ["mse", "psnr", "ssim", "ssim_map", "edge_band", "error_reduction", "outside_local_range"]
 
 # An edge-band pixel is one where the reference and F differ by more than this (they
 # disagree there, so that is where a repair is needed or can harm) ...
@@ -101,3 +101,25 @@ def error_reduction(result, filtered, reference, mask):
     if base <= 0:
         return 0.0
     return 1.0 - mse(result, reference, mask) / base
+
+
+def outside_local_range(image, filtered, slack=1.0 / 255):
+    """Where `image` leaves the colour range of F's 3 x 3 neighbourhood: invented colour.
+
+    Parameters
+    ----------
+    image, filtered : ndarray of float32, shape (H, W, 3)
+    slack : float
+        Allowed excess beyond F's local minimum and maximum, per channel.
+
+    Returns
+    -------
+    ndarray of bool, shape (H, W)
+        True where some channel lies below the 3 x 3 minimum of F minus `slack` or above
+        its maximum plus `slack` (borders replicated).
+    """
+    padded = np.pad(filtered, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    h, w = filtered.shape[:2]
+    windows = [padded[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
+    low, high = np.minimum.reduce(windows), np.maximum.reduce(windows)
+    return ((image < low - slack) | (image > high + slack)).any(axis=-1)

@@ -1,0 +1,363 @@
+"""The real-tools suite: scenes filtered by GEGL, G'MIC and ImageMagick, and its fixed split.
+
+A case is a scene family, an antialiasing space, a tool filter and a source format:
+
+* ``O = box_downsample(scene, k, space)``, saved as the 8-bit file a user has: PNG, or JPEG
+  at one quality (Pillow's encoder, 4:2:0 chroma, decoded by Pillow and handed to the
+  tool as PNG, so that the tool and the recovery see the same pixels);
+* ``F = tool(O)``, read back at 16 bits or as floats (:mod:`aarecovery.lab.tools`);
+* ``reference = box_downsample(tool(scene), k, space)``: the same command on the
+  supersampled scene, lengths (radii, standard deviations) multiplied by ``k``, as
+  :func:`aarecovery.lab.groundtruth.make_case` does for the built-in filters. A tool with
+  per-image state (histogram equalization, G'MIC's ``%`` thresholds of the value range)
+  computes it on the scene as it would on any image. A JPEG case has its PNG case's
+  reference.
+
+Drawings (:mod:`aarecovery.lab.drawings`) are rendered at ``k = 8`` in both antialiasing
+spaces; photos (``core/data/photo_*``, see ``core/data/LICENSE.md``) are their own scene at
+full resolution, box-downsampled by ``k = 4`` in linear light (they are camera images).
+
+**The split.** Every family and every tool filter belongs to one half, ``tune`` or
+``heldout``, and a case exists only where both agree, so that the held-out half has scene
+families *and* tool operations that the tuning half never shows (and every tool has
+operations in both halves). Choose thresholds on ``tune``; report ``heldout``.
+"""
+
+import zlib
+from dataclasses import dataclass, field
+from importlib import resources
+
+import numpy as np
+
+from ..errors import InputError
+from ..plan.resample import box_downsample
+from .drawings import DRAWINGS
+
+__all__ = ["Family", "ToolFilter", "FAMILIES", "TOOL_FILTERS", "HALVES", "POINTWISE_GROUPS", "RealCase",
+           "RealToolsSuite", "REAL_QUICK", "REAL_FULL", "build_cases", "render_family"]
+
+#: The two halves of the split, and "all" (both).
+HALVES = ("tune", "heldout", "all")
+#: Filter groups whose tools act on each pixel alone, as the issue's photo target counts them.
+POINTWISE_GROUPS = ("threshold", "levels", "curves", "posterize")
+_DRAWING_K = 8
+_PHOTO_K = 4
+
+
+@dataclass(frozen=True)
+class Family:
+    """A family of scenes.
+
+    Attributes
+    ----------
+    name : str
+    kind : {"drawing", "photo"}
+    half : {"tune", "heldout"}
+    k : int
+        Supersampling factor: the scene is ``k`` times O's size.
+    source : str
+        For photos, the file in ``core/data``.
+    """
+
+    name: str
+    kind: str
+    half: str
+    k: int
+    source: str = ""
+
+
+FAMILIES = {f.name: f for f in (
+    Family("maps", "drawing", "tune", _DRAWING_K),
+    Family("serif", "drawing", "tune", _DRAWING_K),
+    Family("icons", "drawing", "tune", _DRAWING_K),
+    Family("starburst", "drawing", "tune", _DRAWING_K),
+    Family("hatching", "drawing", "heldout", _DRAWING_K),
+    Family("pies", "drawing", "heldout", _DRAWING_K),
+    Family("inkart", "drawing", "heldout", _DRAWING_K),
+    Family("plots", "drawing", "heldout", _DRAWING_K),
+    # Photos: a grey page of handwriting, a grey portrait, a colour still life, stars on black;
+    # held out: grey lattice towers on a dark sky, a colour portrait, a rocket at dusk, a cat.
+    Family("text", "photo", "tune", _PHOTO_K, "photo_text.png"),
+    Family("camera", "photo", "tune", _PHOTO_K, "photo_camera.png"),
+    Family("coffee", "photo", "tune", _PHOTO_K, "photo_coffee.jpg"),
+    Family("hubble", "photo", "tune", _PHOTO_K, "photo_hubble.jpg"),
+    Family("towers", "photo", "heldout", _PHOTO_K, "photo_towers.png"),
+    Family("astronaut", "photo", "heldout", _PHOTO_K, "photo_astronaut.jpg"),
+    Family("rocket", "photo", "heldout", _PHOTO_K, "photo_rocket.jpg"),
+    Family("chelsea", "photo", "heldout", _PHOTO_K, "photo_chelsea.jpg"),
+)}
+
+
+@dataclass(frozen=True)
+class ToolFilter:
+    """One operation of one tool, with its arguments.
+
+    Attributes
+    ----------
+    name : str
+        ``TOOL-operation``, as tables show it.
+    tool : str
+        A key of :data:`aarecovery.lab.tools.TOOLS`.
+    arguments : tuple of str
+        The command line after the input; ``{name}`` fields are lengths from `lengths`.
+    group : str
+        What kind of filter it is: threshold, levels, curves, posterize, equalize, hue,
+        grey, unsharp or bilateral.
+    half : {"tune", "heldout"}
+    lengths : dict of str to float
+        Lengths in pixels at O's resolution, multiplied by ``k`` on the scene.
+    reach : float
+        How far an output pixel reads, in multiples of the largest length (GEGL's atlas border).
+    whole_image : bool
+        The tool computes per-image state (a histogram).
+    """
+
+    name: str
+    tool: str
+    arguments: tuple
+    group: str
+    half: str
+    lengths: dict = field(default_factory=dict)
+    reach: float = 0.0
+    whole_image: bool = False
+
+    def command(self, scale=1):
+        """The arguments with lengths multiplied by `scale`."""
+        values = {name: f"{length * scale:g}" for name, length in self.lengths.items()}
+        return tuple(argument.format(**values) for argument in self.arguments)
+
+    def support(self, scale=1):
+        """How far, in pixels at `scale`, an output pixel reads."""
+        return self.reach * max(self.lengths.values(), default=0.0) * scale
+
+
+def _tf(name, tool, arguments, group, half, lengths=None, reach=0.0, whole_image=False):
+    return ToolFilter(name, tool, tuple(arguments), group, half, dict(lengths or {}), reach, whole_image)
+
+
+# The operations and their conventions are in docs/quality.md ("How real tools work").
+TOOL_FILTERS = {f.name: f for f in (
+    # Tuning half.
+    _tf("gegl-threshold", "gegl", ["gegl:threshold", "value=0.5"], "threshold", "tune"),
+    _tf("gegl-levels", "gegl", ["gegl:levels", "in-high=0.5"], "levels", "tune"),
+    _tf("gegl-levels-narrow", "gegl", ["gegl:levels", "in-low=0.3", "in-high=0.4"], "levels", "tune"),
+    _tf("gegl-exposure", "gegl", ["gegl:exposure", "exposure=2"], "curves", "tune"),
+    _tf("gegl-posterize", "gegl", ["gegl:posterize", "levels=4"], "posterize", "tune"),
+    _tf("gegl-unsharp", "gegl", ["gegl:unsharp-mask", "std-dev={sigma}", "scale=1"], "unsharp", "tune",
+        {"sigma": 2.0}, reach=6),
+    _tf("gegl-hue-chroma", "gegl", ["gegl:hue-chroma", "hue=90"], "hue", "tune"),
+    _tf("gmic-threshold", "gmic", ["-threshold", "40%", "-mul", "255"], "threshold", "tune", whole_image=True),
+    _tf("gmic-pow3", "gmic", ["-pow", "3"], "curves", "tune"),
+    _tf("gmic-equalize", "gmic", ["-equalize"], "equalize", "tune", whole_image=True),
+    _tf("gmic-bilateral", "gmic", ["-bilateral", "{sigma},20"], "bilateral", "tune", {"sigma": 2.0}, reach=4),
+    _tf("gmic-luminance", "gmic", ["-luminance"], "grey", "tune"),
+    _tf("im-sigmoidal", "imagemagick", ["-sigmoidal-contrast", "8,50%"], "curves", "tune"),
+    _tf("im-unsharp", "imagemagick", ["-unsharp", "0x{sigma}+1.5+0"], "unsharp", "tune", {"sigma": 1.5}, reach=4),
+    # Held-out half.
+    _tf("gegl-brightness-contrast", "gegl", ["gegl:brightness-contrast", "contrast=1.8", "brightness=0.05"],
+        "curves", "heldout"),
+    # gegl:bilateral-filter costs the square of its radius: 3 px (24 on the scene) took 28 s
+    # of the quick held-out half's 39 s of tool time; 1.5 px takes a quarter of that.
+    _tf("gegl-bilateral", "gegl", ["gegl:bilateral-filter", "blur-radius={radius}", "edge-preservation=8"],
+        "bilateral", "heldout", {"radius": 1.5}, reach=1),
+    _tf("gegl-mono-mixer", "gegl", ["gegl:mono-mixer", "red=0.5", "green=0.3", "blue=0.2"], "grey", "heldout"),
+    _tf("gmic-quantize", "gmic", ["-quantize", "4"], "posterize", "heldout", whole_image=True),
+    _tf("gmic-gamma", "gmic", ["-apply_gamma", "2"], "curves", "heldout", whole_image=True),
+    _tf("gmic-unsharp", "gmic", ["-unsharp", "{sigma},2"], "unsharp", "heldout", {"sigma": 1.5}, reach=4),
+    _tf("im-threshold", "imagemagick", ["-threshold", "50%"], "threshold", "heldout"),
+    _tf("im-level", "imagemagick", ["-level", "25%,75%"], "levels", "heldout"),
+    _tf("im-posterize", "imagemagick", ["-posterize", "4"], "posterize", "heldout"),
+    _tf("im-gray", "imagemagick", ["-colorspace", "Gray"], "grey", "heldout"),
+    _tf("im-modulate", "imagemagick", ["-modulate", "100,100,150"], "hue", "heldout"),
+    _tf("im-equalize", "imagemagick", ["-equalize"], "equalize", "heldout", whole_image=True),
+)}
+
+
+@dataclass(frozen=True)
+class RealToolsSuite:
+    """Which real-tools cases an evaluation runs, and the split they belong to.
+
+    Attributes
+    ----------
+    name : str
+    families : tuple of str
+        Keys of :data:`FAMILIES` (each carries its half).
+    filters : tuple of str
+        Keys of :data:`TOOL_FILTERS` (each carries its half).
+    width : int
+        O's width for drawings (photos keep their size: the crop over ``k``).
+    spaces : dict of str to tuple of str
+        Antialiasing spaces per drawing family (photos: linear only).
+    jpeg_qualities : tuple of int
+        Each PNG case gets one JPEG case, at the quality picked from these by its name.
+    """
+
+    name: str
+    families: tuple
+    filters: tuple
+    width: int
+    spaces: dict
+    jpeg_qualities: tuple = (75, 85, 90, 95, 98)
+
+    def cases(self, half="tune"):
+        """The PNG cases of a half, as ``(family, space, filter)`` names, families outermost.
+
+        Parameters
+        ----------
+        half : {"tune", "heldout", "all"}
+
+        Returns
+        -------
+        list of tuple of str
+        """
+        if half not in HALVES:
+            raise InputError(f"half must be one of {', '.join(HALVES)}, got {half!r}")
+        chosen = []
+        for name in self.families:
+            family = FAMILIES[name]
+            if half != "all" and family.half != half:
+                continue
+            spaces = ("linear",) if family.kind == "photo" else self.spaces.get(name, ("linear", "srgb"))
+            for space in spaces:
+                for filter_name in self.filters:
+                    if TOOL_FILTERS[filter_name].half == family.half:
+                        chosen.append((name, space, filter_name))
+        return chosen
+
+    def jpeg_quality(self, family, space, filter_name):
+        """The JPEG quality of a case's JPEG twin: fixed by its name, spread over the qualities."""
+        key = zlib.crc32(f"{family}/{space}/{filter_name}".encode())
+        return self.jpeg_qualities[key % len(self.jpeg_qualities)]
+
+
+_ALL_FAMILIES = tuple(FAMILIES)
+_ALL_FILTERS = tuple(TOOL_FILTERS)
+
+#: Every family in both spaces (photos linear), every tool filter, O 96 px wide: about
+#: 460 PNG cases and as many JPEG ones.
+REAL_FULL = RealToolsSuite("realtools", _ALL_FAMILIES, _ALL_FILTERS, 96,
+                           {name: ("linear", "srgb") for name, f in FAMILIES.items() if f.kind == "drawing"})
+#: Two drawings and two photos per half, one space per drawing, O 64 px wide, JPEG at 85 and
+#: 95: the size for CI and for quick checks while tuning.
+REAL_QUICK = RealToolsSuite("realtools-quick", ("maps", "starburst", "text", "coffee", "hatching", "pies",
+                                                "towers", "rocket"), _ALL_FILTERS, 64,
+                            {"maps": ("srgb",), "starburst": ("linear",), "hatching": ("srgb",),
+                             "pies": ("linear",)}, (85, 95))
+
+
+def render_family(name, width):
+    """A family's scene: float32 ``(H * k, W * k, 3)``, sRGB-encoded, on the 8-bit grid.
+
+    Drawings are square, `width` pixels at O's size; photos are their bundled crop, trimmed
+    to a multiple of ``k``.
+    """
+    family = FAMILIES[name]
+    if family.kind == "drawing":
+        return DRAWINGS[name](width, width, family.k)
+    from PIL import Image
+    with resources.files("aarecovery").joinpath(f"data/{family.source}").open("rb") as handle:
+        image = np.asarray(Image.open(handle).convert("RGB"), np.float32) / np.float32(255)
+    k = family.k
+    return np.ascontiguousarray(image[:image.shape[0] // k * k, :image.shape[1] // k * k])
+
+
+def _quantised(image):
+    return (np.rint(np.clip(image, 0, 1) * 255) / 255).astype(np.float32)
+
+
+def _jpeg_round_trip(image, quality):
+    import io
+
+    from PIL import Image
+    pixels = np.rint(np.clip(image, 0, 1) * 255).astype(np.uint8)
+    grey = bool((pixels == pixels[..., :1]).all())
+    buffer = io.BytesIO()
+    Image.fromarray(pixels[..., 0] if grey else pixels).save(buffer, format="JPEG", quality=quality)
+    buffer.seek(0)
+    with Image.open(buffer) as decoded:
+        return np.asarray(decoded.convert("RGB"), np.float32) / np.float32(255)
+
+
+@dataclass
+class RealCase:
+    """One real-tools case: O, F and the reference, with what made them.
+
+    Attributes
+    ----------
+    family, space, filter_name : str
+    quality : int or None
+        JPEG quality of O, None for PNG.
+    original, filtered, reference : ndarray of float32, shape (H, W, 3)
+    """
+
+    family: str
+    space: str
+    filter_name: str
+    quality: object
+    original: np.ndarray = None
+    filtered: np.ndarray = None
+    reference: np.ndarray = None
+
+
+def build_cases(suite, half="tune", *, jpeg=True, tools=None, progress=None):
+    """Build O, F and the reference of every case of a half, running each tool command once per batch.
+
+    Parameters
+    ----------
+    suite : RealToolsSuite
+    half : {"tune", "heldout", "all"}
+    jpeg : bool
+        Also build each case's JPEG twin (right after its PNG case in the list).
+    tools : collection of str, optional
+        Names of the tools to run (default: every tool); cases of other tools are left out.
+    progress : callable, optional
+        ``progress(label)``, called after each tool command.
+
+    Returns
+    -------
+    list of RealCase
+    """
+    from .tools import TOOLS
+    chosen = [c for c in suite.cases(half) if tools is None or TOOL_FILTERS[c[2]].tool in tools]
+    scenes = {name: render_family(name, suite.width) for name in dict.fromkeys(c[0] for c in chosen)}
+    originals = {}
+    for name, space, _ in chosen:
+        if (name, space, None) not in originals:
+            originals[name, space, None] = _quantised(box_downsample(scenes[name], FAMILIES[name].k, space))
+    cases = []
+    for name, space, filter_name in chosen:
+        cases.append(RealCase(name, space, filter_name, None, originals[name, space, None]))
+        if jpeg:
+            quality = suite.jpeg_quality(name, space, filter_name)
+            if (name, space, quality) not in originals:
+                originals[name, space, quality] = _jpeg_round_trip(originals[name, space, None], quality)
+            cases.append(RealCase(name, space, filter_name, quality, originals[name, space, quality]))
+    for filter_name in dict.fromkeys(c.filter_name for c in cases):
+        spec = TOOL_FILTERS[filter_name]
+        tool = TOOLS[spec.tool]
+        mine = [c for c in cases if c.filter_name == filter_name]
+        families = list(dict.fromkeys(c.family for c in mine))
+        # One batch per scale: O's at scale 1, the scenes at each k (a single batch when
+        # the command has no lengths).
+        batches = {1: [("O", i) for i in range(len(mine))]}
+        for family in families:
+            scale = FAMILIES[family].k if spec.lengths else 1
+            batches.setdefault(scale, []).append(("scene", family))
+        filtered_scenes = {}
+        for scale, members in batches.items():
+            images = [mine[key].original if kind == "O" else scenes[key] for kind, key in members]
+            outputs = tool.run(spec.command(scale), images, support=spec.support(scale), whole_image=spec.whole_image)
+            for (kind, key), output in zip(members, outputs):
+                if kind == "O":
+                    mine[key].filtered = output
+                else:
+                    filtered_scenes[key] = output
+        references = {}
+        for case in mine:
+            key = (case.family, case.space)
+            if key not in references:
+                references[key] = box_downsample(filtered_scenes[case.family], FAMILIES[case.family].k, case.space)
+            case.reference = references[key]
+        if progress is not None:
+            progress(filter_name)
+    return cases

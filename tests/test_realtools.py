@@ -1,0 +1,238 @@
+"""The real-tools bench: its tool runner, ground truth, split and report, run for real on small images.
+
+The tools (GEGL, G'MIC, ImageMagick) are Debian packages that packaging/test.sh installs;
+a missing one fails these tests in CI (CI set) and skips them loudly elsewhere.
+"""
+
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+from aarecovery.lab import realtools
+from aarecovery.lab.drawings import DRAWINGS
+from aarecovery.lab.metrics import outside_local_range
+from aarecovery.lab.peers import joint_bilateral
+from aarecovery.lab.realeval import run_realtools, summarize_realtools
+from aarecovery.lab.realreport import format_realtools
+from aarecovery.lab.tools import TOOLS, read_float_rgb, write_png8
+
+
+def require_tool(name):
+    tool = TOOLS[name]
+    if not tool.available():
+        message = (f"{tool.label} is not installed (none of {', '.join(tool.commands)}); install the Debian "
+                   f"package {tool.package} (packaging/test.sh does)")
+        if os.environ.get("CI"):
+            pytest.fail(message)
+        pytest.skip("REAL-TOOLS TEST NOT RUN: " + message)
+    return tool
+
+
+def _ramp(width=64):
+    """Every 8-bit grey level 0..255 across, in four colour rows: (4, 64, 3) in steps of 1/255 and 4/255."""
+    rng = np.random.default_rng(5)
+    image = rng.integers(0, 256, (6, width, 3)).astype(np.float32) / 255
+    image[0] = (np.arange(width, dtype=np.float32) * 4 % 256 / 255)[:, None]
+    return image
+
+
+def _direct(tool, arguments, image, tmp_path):
+    """The tool run by hand on one file, without the runner's batching, read back independently."""
+    source, target = tmp_path / "in.png", tmp_path / "out.png"
+    write_png8(source, image)
+    if tool.name == "gegl":
+        command = ["gegl", "--", "gegl:load", f"path={source}", *arguments, "gegl:png-save", f"path={target}",
+                   "bitdepth=16"]
+    elif tool.name == "gmic":
+        target = tmp_path / "out.tif"
+        command = ["gmic", "-v", "-", str(source), *arguments, "-o", f"{target},float"]
+    else:
+        command = [tool.executable(), str(source), *arguments, "-depth", "16", f"PNG48:{target}"]
+    subprocess.run(command, check=True, capture_output=True)
+    return read_float_rgb(target, full_scale=255)
+
+
+@pytest.mark.parametrize("name, arguments", [("gegl", ["gegl:threshold", "value=0.5"]),
+                                             ("gmic", ["-threshold", "40%", "-mul", "255"]),
+                                             ("imagemagick", ["-threshold", "50%"])])
+def test_runner_gives_what_the_tool_gives(name, arguments, tmp_path):
+    tool = require_tool(name)
+    image = _ramp()
+    other = np.ascontiguousarray(image[:, ::-1])
+    batch = tool.run(arguments, [image, other])
+    assert batch[0].shape == image.shape and batch[0].dtype == np.float32
+    np.testing.assert_allclose(batch[0], _direct(tool, arguments, image, tmp_path), atol=1e-6)
+    np.testing.assert_allclose(batch[1], _direct(tool, arguments, other, tmp_path), atol=1e-6)
+
+
+@pytest.mark.parametrize("name", ["gegl", "gmic", "imagemagick"])
+def test_identity_command_returns_the_input(name):
+    tool = require_tool(name)
+    image = _ramp()
+    grey = np.repeat(image[..., :1], 3, axis=2)
+    for result, source in zip(tool.run([], [image, grey]), (image, grey)):
+        np.testing.assert_allclose(result, source, atol=1e-6)
+
+
+def test_gegl_atlas_keeps_spatial_operations_apart():
+    tool = require_tool("gegl")
+    spec = realtools.TOOL_FILTERS["gegl-unsharp"]
+    rng = np.random.default_rng(1)
+    a = np.rint(rng.random((20, 30, 3)) * 255).astype(np.float32) / 255
+    b = np.zeros((12, 40, 3), np.float32)
+    alone = tool.run(spec.command(), [a], support=spec.support())[0]
+    together = tool.run(spec.command(), [b, a], support=spec.support())[1]
+    # GEGL's Gaussian is recursive (IIR): a black neighbour 6 sigma away still moves a pixel
+    # by up to 1.7e-4, a twentieth of an 8-bit step.
+    np.testing.assert_allclose(together, alone, atol=0.5 / 255)
+
+
+def test_tool_conventions_measured_in_the_docs():
+    # docs/quality.md, "How real tools work": GEGL thresholds sRGB-encoded luminance (babl's
+    # D50 weights); ImageMagick 6 thresholds the Rec. 709 luma of encoded values.
+    from aarecovery.colour import linear_to_srgb, srgb_to_linear
+    image = _ramp()
+    gegl = require_tool("gegl").run(["gegl:threshold", "value=0.5"], [image])[0]
+    luminance = linear_to_srgb(srgb_to_linear(image) @ np.array([0.22248840, 0.71690369, 0.06060791], np.float32))
+    np.testing.assert_array_equal(gegl[..., 0], (luminance >= 0.5).astype(np.float32))
+    magick = require_tool("imagemagick").run(["-threshold", "50%"], [image])[0]
+    luma = image @ np.array([0.2126, 0.7152, 0.0722], np.float32)
+    np.testing.assert_array_equal(magick[..., 0], (luma > 0.5).astype(np.float32))
+
+
+def test_split_is_disjoint_and_covers_each_suite():
+    for suite in (realtools.REAL_QUICK, realtools.REAL_FULL):
+        tune, heldout, every = (set(suite.cases(h)) for h in realtools.HALVES)
+        assert tune and heldout and not tune & heldout
+        assert every == tune | heldout
+        for family, _, filter_name in every:
+            assert realtools.FAMILIES[family].half == realtools.TOOL_FILTERS[filter_name].half
+        assert {c[0] for c in every} == set(suite.families)
+        assert {c[2] for c in every} == set(suite.filters)
+    # Each half has drawings and photos, and every tool has operations in both halves.
+    for half in ("tune", "heldout"):
+        assert {f.kind for f in realtools.FAMILIES.values() if f.half == half} == {"drawing", "photo"}
+        assert {f.tool for f in realtools.TOOL_FILTERS.values() if f.half == half} == set(TOOLS)
+    with pytest.raises(Exception, match="half must be one of"):
+        realtools.REAL_QUICK.cases("test")
+
+
+def test_jpeg_quality_is_fixed_by_the_case_name():
+    suite = realtools.REAL_FULL
+    qualities = {suite.jpeg_quality(*case) for case in suite.cases("all")}
+    assert qualities == set(suite.jpeg_qualities)
+    assert suite.jpeg_quality("maps", "srgb", "gegl-threshold") == suite.jpeg_quality("maps", "srgb", "gegl-threshold")
+
+
+def test_identity_tools_give_a_reference_equal_to_o(monkeypatch):
+    # With an identity command the reference is box(scene) and F is O: both equal O within
+    # O's 8-bit rounding (and the 16-bit or float read-back).
+    for name in TOOLS:
+        require_tool(name)
+        monkeypatch.setitem(realtools.TOOL_FILTERS, f"{name}-identity",
+                            realtools.ToolFilter(f"{name}-identity", name, (), "curves", "tune"))
+    suite = realtools.RealToolsSuite("identity", ("starburst", "text"), tuple(f"{n}-identity" for n in TOOLS), 24,
+                                     {"starburst": ("linear", "srgb")})
+    cases = realtools.build_cases(suite, "tune")
+    assert len(cases) == 2 * 3 * len(TOOLS)  # (2 spaces + 1 photo) x tools, each with its JPEG twin
+    for case in cases:
+        np.testing.assert_allclose(case.filtered, case.original, atol=1e-6)
+        if case.quality is None:
+            np.testing.assert_allclose(case.reference, case.original, atol=0.5 / 255 + 1e-4)
+
+
+def test_drawings_are_deterministic_and_hard_edged():
+    for name, render in DRAWINGS.items():
+        first, second = render(16, 16, 4), render(16, 16, 4)
+        assert first.shape == (64, 64, 3) and first.dtype == np.float32
+        np.testing.assert_array_equal(first, second)
+        np.testing.assert_array_equal(np.rint(first * 255) / 255, first.astype(np.float64), err_msg=name)
+        assert len(np.unique(first.reshape(-1, 3), axis=0)) <= 16, name
+
+
+def test_serif_scene_says_which_font_is_missing(monkeypatch):
+    from aarecovery import InputError
+    from aarecovery.lab import drawings
+    monkeypatch.setattr(drawings, "SERIF_FONT", "/nonexistent/DejaVuSerif.ttf")
+    with pytest.raises(InputError, match="fonts-dejavu-core"):
+        drawings.DRAWINGS["serif"](16, 16, 2)
+
+
+def test_joint_bilateral_keeps_o_edges_and_smooths_flat_regions():
+    guide = np.zeros((8, 12, 3), np.float32)
+    guide[:, 6:] = 1
+    filtered = guide.copy()
+    filtered[2, 1] = 0.5  # noise inside a flat region of O
+    result = joint_bilateral(filtered, guide)
+    assert abs(result[2, 1, 0] - 0.5) > 0.2  # smoothed towards its neighbours
+    np.testing.assert_allclose(result[:, 5:7], guide[:, 5:7], atol=1e-3)  # the edge stays sharp
+    np.testing.assert_allclose(joint_bilateral(guide, guide), guide, atol=1e-6)
+
+
+def test_outside_local_range_finds_invented_colour():
+    filtered = np.zeros((6, 6, 3), np.float32)
+    filtered[:, 3:] = 1
+    image = filtered.copy()
+    image[1, 1] = (0.5, 0, 0)  # inside a flat black region: new colour
+    image[1, 3] = (0.5, 0.5, 0.5)  # on the edge: within the local range
+    mask = outside_local_range(image, filtered)
+    assert mask[1, 1] and not mask[1, 3] and mask.sum() == 1
+
+
+def test_small_suite_end_to_end_with_each_tool():
+    for name in TOOLS:
+        require_tool(name)
+    suite = realtools.RealToolsSuite("tiny", ("starburst", "text"),
+                                     ("gegl-threshold", "gmic-threshold", "im-sigmoidal"), 24,
+                                     {"starburst": ("srgb",)}, (90,))
+    results, missing_tools, missing_peers = run_realtools(suite, "tune", peers=True)
+    assert not missing_tools
+    assert len(results) == 2 * 3 * 2
+    assert {r.tool for r in results} == set(TOOLS) and {r.source for r in results} == {"png", "jpeg90"}
+    for r in results:
+        assert {"F", "R", "paper", "jbf"} <= set(r.psnr_band) and r.plan
+        assert 0 <= r.changed <= 1 and r.max_change >= 0 and r.outside["R"] >= 0
+        assert r.half == "tune"
+    summary = summarize_realtools(results)
+    assert summary["hard_cases"] > 0 and "q>=85" in summary["jpeg_gain_kept"]
+    table = format_realtools(results, missing_tools, missing_peers, suite_name="tiny", half="tune")
+    assert "starburst/srgb/gegl-threshold/png" in table and "== targets of issue 10" in table
+    assert "HELD-OUT" not in table
+    assert "HELD-OUT" in format_realtools(results, half="heldout")
+
+
+def test_missing_tools_are_reported_loudly():
+    from aarecovery.lab.peers import PEERS
+    from aarecovery.lab.realeval import RealCaseResult
+    result = RealCaseResult("maps", "srgb", "gegl-threshold", "drawing", 0.5, psnr={"F": 10, "R": 12},
+                            ssim={"F": 0.5, "R": 0.6}, psnr_band={"F": 10, "R": 12}, ssim_band={"F": 0.5, "R": 0.6},
+                            reduction={"R": 0.37}, tool="gegl", group="threshold", half="tune")
+    table = format_realtools([result], missing_tools=list(TOOLS.values()), missing_peers=PEERS)
+    assert table.count("NOT installed") == len(TOOLS) + len(PEERS)
+    assert "imagemagick" in table and "gmic" in table and "maps/srgb/gegl-threshold/png" in table
+
+
+def test_eval_command_runs_the_realtools_suite(capsys):
+    from aarecovery.cli import main
+    for name in ("gegl",):
+        require_tool(name)
+    assert main(["eval", "--suite", "realtools", "--scenes", "starburst", "--filters", "gegl-threshold",
+                 "--width", "24", "--no-jpeg", "--no-peers"]) == 0
+    out = capsys.readouterr().out
+    assert "starburst/linear/gegl-threshold/png" in out and "half 'tune'" in out
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--suite", "realtools", "--filters", "im-threshold"], "belongs to the heldout half"),
+    (["--suite", "realtools", "--scenes", "towers"], "belongs to the heldout half"),
+    (["--suite", "realtools", "--half", "test"], "--half must be one of"),
+    (["--suite", "realtools", "--k", "4"], "--k applies to the built-in suite only"),
+    (["--half", "heldout"], "--half applies to --suite realtools only"),
+    (["--suite", "realtools", "--filters", "nosuch"], "unknown filter 'nosuch'"),
+])
+def test_eval_command_refuses_crossing_the_split(argv, message, capsys):
+    from aarecovery.cli import main
+    assert main(["eval", *argv]) == 1
+    assert message in capsys.readouterr().err
