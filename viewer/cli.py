@@ -75,9 +75,9 @@ def run(args):
         return 1
     from aarecovery import InputError
 
-    from .app import ViewerApp, WindowError, sample_source
+    from .app import ViewerApp, WindowError
     from .settings import RecoverySettings
-    from .sources import SAMPLE_FILTER, PairSource
+    from .sources import SAMPLE_FILTER, PairSource, sample_source
 
     window_size = _size(args.size, "--size")
     if args.filtered and args.filter_name:
@@ -97,9 +97,9 @@ def run(args):
     except WindowError as error:
         raise InputError(str(error)) from None
     try:
-        app.set_view_mode(args.view)
+        app.comparison.set_view_mode(args.view)
         if source is None:
-            app.show_error("the bundled sample is not in this install; open files from the panel")
+            app.messages.error("the bundled sample is not in this install; open files from the panel")
         if args.screenshot:
             return _screenshot(app, args.screenshot)
         app.run()

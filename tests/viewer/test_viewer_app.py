@@ -72,29 +72,29 @@ def test_scripted_session(app, image_pair):
     from aarecovery import read_image
     from aarecovery.viewer.sources import PairSource
 
-    assert app.open(PairSource(*image_pair))
+    assert app.opener.open(PairSource(*image_pair))
     frames(app, 3)
-    assert app.recoveries == 1 and app.computed[0] == app.settings
+    assert app.recovery.recoveries == 1 and app.recovery.computed[0] == app.recovery.settings
 
     # Slider drag: sigma_e from 30% to 80% of its (logarithmic) track.
     left, top, right, bottom = app.widget_rects["sigma_e"]
     y = (top + bottom) / 2
     drag(app, (left + 0.3 * (right - left), y), (left + 0.8 * (right - left), y))
     # The track runs from 0.0005 to 0.5 logarithmically; its ends are inset by the grab's half width.
-    assert 0.0005 * 1000 ** 0.7 < app.settings.sigma_e < 0.0005 * 1000 ** 0.9
-    assert app.computed[0] == app.settings, "R is recomputed for the new value"
-    recoveries = app.recoveries
+    assert 0.0005 * 1000 ** 0.7 < app.recovery.settings.sigma_e < 0.0005 * 1000 ** 0.9
+    assert app.recovery.computed[0] == app.recovery.settings, "R is recomputed for the new value"
+    recoveries = app.recovery.recoveries
     frames(app, 3)
-    assert app.recoveries == recoveries, "nothing is recomputed while nothing changes"
+    assert app.recovery.recoveries == recoveries, "nothing is recomputed while nothing changes"
 
     # Keys: split view, 1:1 zoom.
     key(app, glfw.KEY_4)
-    assert app.view_mode == "split"
+    assert app.comparison.view_mode == "split"
     key(app, glfw.KEY_Z)
     assert app.view.zoom == 1
 
     # Divider drag to a quarter of the image area.
-    area, scale = app._area()
+    area, scale = app.image_area()
     divider_x = (area[0] + app.view.split_x) / scale
     target_x = (area[0] + 0.25 * area[2]) / scale
     drag(app, (divider_x, 300), (target_x, 300))
@@ -133,20 +133,20 @@ def test_scripted_session(app, image_pair):
 
     # Flicker swaps the sides; the heat-map shows |R - F|.
     key(app, glfw.KEY_SPACE)
-    assert app.side_names() == ("R", "F")
+    assert app.comparison.side_names() == ("R", "F")
     key(app, glfw.KEY_5)
-    assert app.view_mode == "difference"
+    assert app.comparison.view_mode == "difference"
     key(app, glfw.KEY_7)
-    assert app.view_mode == "beta" and app.computed[1], "map views compute the maps"
+    assert app.comparison.view_mode == "beta" and app.recovery.computed[1], "map views compute the maps"
 
     # Help overlay and the copied command line.
     key(app, glfw.KEY_H)
-    assert app.help_visible
+    assert app.panel.help_visible
     key(app, glfw.KEY_ESCAPE)
-    assert not app.help_visible
+    assert not app.panel.help_visible
     key(app, glfw.KEY_C, glfw.MOD_CONTROL | glfw.MOD_SHIFT)
     copied = glfw.get_clipboard_string(None).decode()
-    assert copied.startswith("aarecovery recover ") and f"--sigma-e {app.settings.sigma_e:g}" in copied
+    assert copied.startswith("aarecovery recover ") and f"--sigma-e {app.recovery.settings.sigma_e:g}" in copied
 
 
 
@@ -154,18 +154,18 @@ def test_saving_never_replaces_an_input_unless_confirmed(app, image_pair, tmp_pa
     from aarecovery import read_image
     from aarecovery.viewer.sources import PairSource
 
-    assert app.open(PairSource(*image_pair))
+    assert app.opener.open(PairSource(*image_pair))
     frames(app, 2)
     before = open(image_pair[1], "rb").read()
-    assert not app.request_save(image_pair[1])
-    assert app.pending_overwrite is not None and "FILTERED input" in app.pending_overwrite[1]
+    assert not app.saving.request(image_pair[1])
+    assert app.panel.pending_overwrite is not None and "FILTERED input" in app.panel.pending_overwrite[1]
     frames(app, 2)
     assert open(image_pair[1], "rb").read() == before, "nothing is written before the confirmation"
-    assert app.confirm_overwrite()
+    assert app.saving.confirm_overwrite()
     np.testing.assert_array_equal(read_image(image_pair[1]), app.engine.result())
 
     fresh = tmp_path / "fresh.png"
-    assert app.request_save(str(fresh))
+    assert app.saving.request(str(fresh))
     np.testing.assert_array_equal(read_image(fresh), app.engine.result())
 
 
@@ -179,16 +179,16 @@ def test_bad_input_shows_a_message_and_keeps_running(app, image_pair, tmp_path):
     from aarecovery import write_image
     from aarecovery.viewer.sources import PairSource
 
-    assert app.open(PairSource(*image_pair))
+    assert app.opener.open(PairSource(*image_pair))
     frames(app, 2)
-    shown = app.pair
+    shown = app.recovery.pair
 
     garbage = tmp_path / "garbage.png"
     garbage.write_bytes(b"\x89PNG\r\n\x1a\n this is not a PNG")
     app.platform.drop_callback(app.window, [str(garbage), image_pair[1]])
     frames(app, 3)
     assert app.messages and app.messages[-1].error and "garbage.png" in app.messages[-1].text
-    assert app.pair is shown
+    assert app.recovery.pair is shown
     app.step(capture=True)
     assert _error_pixels(app.last_screenshot) > 50, "the error is shown in the window"
 
@@ -197,14 +197,14 @@ def test_bad_input_shows_a_message_and_keeps_running(app, image_pair, tmp_path):
     app.platform.drop_callback(app.window, [image_pair[0], str(small)])
     frames(app, 2)
     assert "pixel for pixel" in app.messages[-1].text
-    assert app.pair is shown and app.step(), "the app keeps running and showing the last good pair"
-    assert app.computed is not None and app.computed[0] == app.settings
+    assert app.recovery.pair is shown and app.step(), "the app keeps running and showing the last good pair"
+    assert app.recovery.computed is not None and app.recovery.computed[0] == app.recovery.settings
 
     # A single dropped file asks what it is; used as FILTERED it is checked like the others.
     app.platform.drop_callback(app.window, [str(small)])
     frames(app, 2)
-    assert app.pending_drop == str(small)
-    assert not app.use_dropped_as("filtered")
+    assert app.panel.pending_drop == str(small)
+    assert not app.opener.use_dropped_as("filtered")
     assert "pixel for pixel" in app.messages[-1].text and app.step()
 
 
