@@ -16,7 +16,6 @@ import numpy as np
 import aarecovery
 
 from .app import ViewerApp
-from .settings import supported_modes
 from .sources import PairSource
 
 __all__ = ["run_bench", "make_bench_pair"]
@@ -131,11 +130,11 @@ def run_bench(original, filtered, filter_name, image_size, window_size):
             print(f"idle frame time ({len(idle)} frames): {_milliseconds(idle)} "
                   f"-> {1 / statistics.median(idle):.0f} frames per second")
             failed = False
-            for mode in supported_modes() or (None,):
+            for mode in aarecovery.MODES:
                 app.recovery.settings = app.recovery.settings.with_values(mode=mode)
                 _frame(app)
                 latencies = _slider_latencies(app)
-                label = f"mode={mode}" if mode else "recovery"
+                label = f"mode={mode}"
                 if len(latencies) < _SLIDER_CHANGES:
                     print(f"slider-to-frame latency, {label}: {_SLIDER_CHANGES - len(latencies)} changes never showed")
                     failed = True

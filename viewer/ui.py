@@ -10,8 +10,10 @@ import os
 
 from imgui_bundle import imgui
 
-from . import settings as settings_module
+import aarecovery
+
 from .keys import KEY_HELP, VIEW_MODES
+from .settings import RecoverySettings
 from .sources import filter_names, filter_parameters
 from .status import status_lines
 
@@ -23,6 +25,8 @@ PANEL_WIDTH = 330.0
 _ERROR = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 _INFO = imgui.ImVec4(0.6, 0.85, 1.0, 1.0)
 _DIM = imgui.ImVec4(0.65, 0.65, 0.65, 1.0)
+# Slider values: three significant digits suit logarithmic ranges (ImGui rounds to them too).
+_FLOAT_FORMAT = "%.3g"
 _FIXED = (imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize | imgui.WindowFlags_.no_collapse
           | imgui.WindowFlags_.no_saved_settings)
 
@@ -110,28 +114,33 @@ def _files_section(app):
     imgui.text_colored(_DIM, "or drop files on the window")
 
 
+def _parameter_slider(app, spec, value):
+    """A slider over one parameter's valid range, with its label and help from ``PARAMETERS``."""
+    flags = imgui.SliderFlags_.always_clamp
+    if spec.logarithmic:
+        flags |= imgui.SliderFlags_.logarithmic
+    if spec.kind is int:
+        _, value = imgui.slider_int(spec.label, value, spec.minimum, spec.maximum, "%d", flags)
+    else:
+        _, value = imgui.slider_float(spec.label, value, spec.minimum, spec.maximum, _FLOAT_FORMAT, flags)
+    _record(app, spec.name)
+    if imgui.is_item_hovered():
+        imgui.set_tooltip(spec.help)
+    return value
+
+
 def _parameters_section(app):
     if not imgui.collapsing_header("Recovery", imgui.TreeNodeFlags_.default_open):
         return
-    s = app.recovery.settings
-    clamp = imgui.SliderFlags_.always_clamp
-    _, sigma_d = imgui.slider_float("sigma_d", s.sigma_d, *settings_module.SIGMA_D_RANGE, "%.4f",
-                                    clamp | imgui.SliderFlags_.logarithmic)
-    _record(app, "sigma_d")
-    _, sigma_e = imgui.slider_float("sigma_e", s.sigma_e, *settings_module.SIGMA_E_RANGE, "%.5f",
-                                    clamp | imgui.SliderFlags_.logarithmic)
-    _record(app, "sigma_e")
-    _, iterations = imgui.slider_int("iterations", s.iterations, *settings_module.ITERATIONS_RANGE, "%d", clamp)
-    _record(app, "iterations")
-    mode = s.mode
-    modes = settings_module.supported_modes()
-    if modes:
-        changed, index = imgui.combo("mode", modes.index(mode) if mode in modes else 0, list(modes))
-        _record(app, "mode")
-        mode = modes[index]
-    app.recovery.settings = s.with_values(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode)
+    settings = app.recovery.settings
+    values = {name: _parameter_slider(app, spec, getattr(settings, name))
+              for name, spec in aarecovery.PARAMETERS.items()}
+    modes = list(aarecovery.MODES)
+    _, index = imgui.combo("mode", modes.index(settings.mode), modes)
+    _record(app, "mode")
+    app.recovery.settings = settings.with_values(mode=modes[index], **values)
     if imgui.button("Paper defaults"):
-        app.recovery.settings = settings_module.RecoverySettings.defaults()
+        app.recovery.settings = RecoverySettings.defaults()
     imgui.same_line()
     imgui.text_colored(_DIM, "ctrl+click a slider to type")
 

@@ -69,6 +69,7 @@ def centre(rect):
 def test_scripted_session(app, image_pair):
     import glfw
 
+    import aarecovery
     from aarecovery import read_image
     from aarecovery.viewer.sources import PairSource
 
@@ -80,8 +81,10 @@ def test_scripted_session(app, image_pair):
     left, top, right, bottom = app.widget_rects["sigma_e"]
     y = (top + bottom) / 2
     drag(app, (left + 0.3 * (right - left), y), (left + 0.8 * (right - left), y))
-    # The track runs from 0.0005 to 0.5 logarithmically; its ends are inset by the grab's half width.
-    assert 0.0005 * 1000 ** 0.7 < app.recovery.settings.sigma_e < 0.0005 * 1000 ** 0.9
+    # The track spans sigma_e's valid range logarithmically; its ends are inset by the grab's half width.
+    spec = aarecovery.PARAMETERS["sigma_e"]
+    ratio = spec.maximum / spec.minimum
+    assert spec.minimum * ratio ** 0.7 < app.recovery.settings.sigma_e < spec.minimum * ratio ** 0.9
     assert app.recovery.computed[0] == app.recovery.settings, "R is recomputed for the new value"
     recoveries = app.recovery.recoveries
     frames(app, 3)
@@ -148,6 +151,42 @@ def test_scripted_session(app, image_pair):
     copied = glfw.get_clipboard_string(None).decode()
     assert copied.startswith("aarecovery recover ") and f"--sigma-e {app.recovery.settings.sigma_e:g}" in copied
 
+
+def test_copied_command_line_reproduces_the_shown_result(app, image_pair, tmp_path):
+    import shlex
+
+    import glfw
+
+    import aarecovery
+    from aarecovery.cli import build_parser, main
+    from aarecovery.viewer.sources import PairSource
+
+    assert app.opener.open(PairSource(*image_pair))
+    frames(app, 3)
+    left, top, right, bottom = app.widget_rects["sigma_e"]
+    y = (top + bottom) / 2
+    drag(app, (left + 0.5 * (right - left), y), (left + 0.63 * (right - left), y))
+    assert app.recovery.settings.sigma_e != aarecovery.PARAMETERS["sigma_e"].default
+    for mode in aarecovery.MODES:
+        app.recovery.settings = app.recovery.settings.with_values(mode=mode)
+        app.panel.save_path = str(tmp_path / f"r-{mode}.png")
+        frames(app, 2)
+        assert app.recovery.computed[0].mode == mode
+        key(app, glfw.KEY_C, glfw.MOD_CONTROL | glfw.MOD_SHIFT)
+        words = shlex.split(glfw.get_clipboard_string(None).decode())
+        assert words[0] == "aarecovery"
+        build_parser().parse_args(words[1:])  # the real parser accepts it (exits otherwise)
+        assert main(words[1:]) == 0
+        np.testing.assert_array_equal(aarecovery.read_image(app.panel.save_path), app.engine.result(),
+                                      err_msg=f"mode {mode}")
+
+
+def test_view_refuses_parameters_out_of_range(capsys):
+    require_viewer_extra()
+    from aarecovery.cli import main
+    assert main(["view", "--sigma-e", "5"]) == 1
+    error = capsys.readouterr().err
+    assert error.startswith("aarecovery: error: sigma_e must be") and error.count("\n") == 1
 
 
 def test_saving_never_replaces_an_input_unless_confirmed(app, image_pair, tmp_path):
