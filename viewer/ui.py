@@ -25,8 +25,15 @@ PANEL_WIDTH = 330.0
 _ERROR = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 _INFO = imgui.ImVec4(0.6, 0.85, 1.0, 1.0)
 _DIM = imgui.ImVec4(0.65, 0.65, 0.65, 1.0)
+#: Range of the flicker period slider, in seconds.
+FLICKER_PERIODS = (0.1, 2.0)
+#: Range of the heat-map gain slider.
+HEAT_MAP_GAINS = (1.0, 64.0)
 # Slider values: three significant digits suit logarithmic ranges (ImGui rounds to them too).
 _FLOAT_FORMAT = "%.3g"
+# The value column of a slider is as wide as this text (the widest %.3g of the parameters'
+# ranges, 0.000123), or as the value if that is wider.
+_VALUE_COLUMN = "0.000000"
 _FIXED = (imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize | imgui.WindowFlags_.no_collapse
           | imgui.WindowFlags_.no_saved_settings)
 
@@ -114,19 +121,46 @@ def _files_section(app):
     imgui.text_colored(_DIM, "or drop files on the window")
 
 
+def _slider(app, key, label, value, minimum, maximum, display_format, flags=0, help_text=None):
+    """A slider with its value beside the track, where the grab cannot cover it.
+
+    ImGui draws a slider's value centred on the track, under which the grab passes and hid
+    digits. Here the frame draws nothing (ImGui shows no text after ``##``; ctrl+click
+    editing and the rounding of dragged values still use the format after it) and the value
+    is a text item between the track and the label, whose column fits the widest value.
+
+    Returns
+    -------
+    The new value (int when `minimum` is an int).
+    """
+    style = imgui.get_style()
+    start_x = imgui.get_cursor_pos_x()
+    width = imgui.calc_item_width()
+    spacing = style.item_inner_spacing.x
+    column = max(imgui.calc_text_size(_VALUE_COLUMN).x, imgui.calc_text_size(display_format % value).x)
+    imgui.set_next_item_width(max(1.0, width - column - spacing))
+    slide = imgui.slider_int if isinstance(minimum, int) else imgui.slider_float
+    _, value = slide(f"##{key}", value, minimum, maximum, "##" + display_format, flags)
+    _record(app, key)
+    hovered = imgui.is_item_hovered()
+    imgui.same_line(0, spacing)
+    imgui.text(display_format % value)
+    low, high = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+    app.widget_rects[f"{key} value"] = (low.x, low.y, high.x, high.y)
+    imgui.same_line(max(start_x + width + spacing, imgui.get_cursor_pos_x()))
+    imgui.text(label)
+    if help_text and (hovered or imgui.is_item_hovered()):
+        imgui.set_tooltip(help_text)
+    return value
+
+
 def _parameter_slider(app, spec, value):
     """A slider over one parameter's valid range, with its label and help from ``PARAMETERS``."""
     flags = imgui.SliderFlags_.always_clamp
     if spec.logarithmic:
         flags |= imgui.SliderFlags_.logarithmic
-    if spec.kind is int:
-        _, value = imgui.slider_int(spec.label, value, spec.minimum, spec.maximum, "%d", flags)
-    else:
-        _, value = imgui.slider_float(spec.label, value, spec.minimum, spec.maximum, _FLOAT_FORMAT, flags)
-    _record(app, spec.name)
-    if imgui.is_item_hovered():
-        imgui.set_tooltip(spec.help)
-    return value
+    return _slider(app, spec.name, spec.label, value, spec.minimum, spec.maximum,
+                   "%d" if spec.kind is int else _FLOAT_FORMAT, flags, spec.help)
 
 
 def _parameters_section(app):
@@ -162,11 +196,10 @@ def _view_section(app):
     if imgui.radio_button("with O", comparison.compare_with == "original"):
         comparison.compare_with = "original"
     _, comparison.auto_flicker = imgui.checkbox("flicker (K)", comparison.auto_flicker)
-    imgui.same_line()
-    _, comparison.flicker_period = imgui.slider_float("##period", comparison.flicker_period, 0.1, 2.0,
-                                                      "every %.2f s")
-    _, comparison.difference_gain = imgui.slider_float("heat-map gain", comparison.difference_gain, 1.0, 64.0,
-                                                       "x%.1f", imgui.SliderFlags_.logarithmic)
+    comparison.flicker_period = _slider(app, "flicker_period", "flicker period", comparison.flicker_period,
+                                        *FLICKER_PERIODS, "%.2f s")
+    comparison.difference_gain = _slider(app, "difference_gain", "heat-map gain", comparison.difference_gain,
+                                         *HEAT_MAP_GAINS, "x%.1f", imgui.SliderFlags_.logarithmic)
     if imgui.button("Fit (F)"):
         app.view.fit()
     imgui.same_line()

@@ -189,6 +189,51 @@ def test_view_refuses_parameters_out_of_range(capsys):
     assert error.startswith("aarecovery: error: sigma_e must be") and error.count("\n") == 1
 
 
+def _pixels_of_colour(shot, rgba):
+    target = np.rint(np.array([rgba.x, rgba.y, rgba.z]) * 255).astype(int)
+    return (np.abs(shot.astype(int) - target) <= 2).all(axis=-1)
+
+
+def test_slider_grab_never_covers_the_value(app, image_pair):
+    """Issue 13 item 8: the grab hid digits of the value drawn on the track."""
+    from imgui_bundle import imgui
+
+    import aarecovery
+    from aarecovery.viewer import ui
+    from aarecovery.viewer.sources import PairSource
+
+    assert app.opener.open(PairSource(*image_pair))
+    frames(app, 3)
+    style = imgui.get_style()  # the app's ImGui context is the current one
+
+    def set_parameter(name):
+        return lambda value: setattr(app.recovery, "settings", app.recovery.settings.with_values(**{name: value}))
+    sliders = {name: (spec.minimum, spec.maximum, spec.logarithmic, set_parameter(name))
+               for name, spec in aarecovery.PARAMETERS.items()}
+    sliders["flicker_period"] = (*ui.FLICKER_PERIODS, False, lambda v: setattr(app.comparison, "flicker_period", v))
+    sliders["difference_gain"] = (*ui.HEAT_MAP_GAINS, True, lambda v: setattr(app.comparison, "difference_gain", v))
+    for key, (low, high, logarithmic, set_value) in sliders.items():
+        middle = (low * high) ** 0.5 if logarithmic else (low + high) / 2
+        for value in (low, type(low)(middle), high):
+            set_value(value)
+            frames(app, 2)
+            app.step(capture=True)
+            track = [int(round(v)) for v in app.widget_rects[key]]
+            number = [int(round(v)) for v in app.widget_rects[f"{key} value"]]
+            band = app.last_screenshot[track[1]:track[3]]
+            grab = _pixels_of_colour(band, style.color_(imgui.Col_.slider_grab))
+            text = band.min(axis=-1) > 200  # ImGui's text is white; nothing else in the panel is
+            grab_columns = np.nonzero(grab.any(axis=0))[0]
+            where = f"{key} = {value}"
+            assert grab_columns.size and track[0] <= grab_columns[0] and grab_columns[-1] < track[2], where
+            assert not text[:, grab_columns[0]:grab_columns[-1] + 1].any(), f"text under the grab: {where}"
+            # The value: beside the track, inside the panel's clip rectangle, all of it drawn.
+            assert track[2] <= number[0] and number[2] <= app.panel_width - style.window_padding.x / 2, where
+            assert not grab[:, number[0]:number[2]].any(), where
+            drawn = np.nonzero(text[:, number[0]:number[2]].any(axis=0))[0]
+            assert drawn.size and drawn[0] <= 1 and drawn[-1] >= number[2] - number[0] - 2, where
+
+
 def test_saving_never_replaces_an_input_unless_confirmed(app, image_pair, tmp_path):
     from aarecovery import read_image
     from aarecovery.viewer.sources import PairSource
