@@ -223,8 +223,15 @@ def _actions_section(app):
 
 def _status_section(app):
     imgui.separator()
+    imgui.push_text_wrap_pos(0.0)  # long lines wrap at the panel's edge
     for line in status_lines(app):
-        imgui.text_colored(_DIM, line)
+        imgui.text_colored(_DIM, line.text)
+        if line.detail and imgui.is_item_hovered() and imgui.begin_tooltip():
+            imgui.push_text_wrap_pos(imgui.get_font_size() * 35)
+            imgui.text_unformatted(line.detail)
+            imgui.pop_text_wrap_pos()
+            imgui.end_tooltip()
+    imgui.pop_text_wrap_pos()
     imgui.text_colored(_DIM, "H or F1: keys")
 
 

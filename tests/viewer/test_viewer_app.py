@@ -76,6 +76,8 @@ def test_scripted_session(app, image_pair):
     assert app.opener.open(PairSource(*image_pair))
     frames(app, 3)
     assert app.recovery.recoveries == 1 and app.recovery.computed[0] == app.recovery.settings
+    from aarecovery.viewer.status import plan_line, status_lines
+    assert plan_line(app.engine).text.startswith("safe: ") and plan_line(app.engine) in status_lines(app)
 
     # Slider drag: sigma_e from 30% to 80% of its (logarithmic) track.
     left, top, right, bottom = app.widget_rects["sigma_e"]
