@@ -236,6 +236,29 @@ def test_slider_grab_never_covers_the_value(app, image_pair):
             assert drawn.size and drawn[0] <= 1 and drawn[-1] >= number[2] - number[0] - 2, where
 
 
+def test_ctrl_click_on_a_slider_types_its_value(app, image_pair):
+    import glfw
+
+    from aarecovery.viewer.sources import PairSource
+
+    assert app.opener.open(PairSource(*image_pair))
+    frames(app, 3)
+    app.platform.key_callback(app.window, glfw.KEY_LEFT_CONTROL, 0, glfw.PRESS, 0)
+    move(app, *centre(app.widget_rects["sigma_e"]))
+    frames(app, 1)
+    for action in (glfw.PRESS, glfw.RELEASE):
+        app.platform.mouse_button_callback(app.window, glfw.MOUSE_BUTTON_LEFT, action, glfw.MOD_CONTROL)
+        frames(app, 1)
+    app.platform.key_callback(app.window, glfw.KEY_LEFT_CONTROL, 0, glfw.RELEASE, glfw.MOD_CONTROL)
+    frames(app, 1)
+    for character in "0.0437":  # replaces the selected text of the field
+        app.platform.char_callback(app.window, ord(character))
+        frames(app, 1)
+    key(app, glfw.KEY_ENTER)
+    assert app.recovery.settings.sigma_e == pytest.approx(0.0437)
+    assert app.recovery.computed[0] == app.recovery.settings
+
+
 def test_saving_never_replaces_an_input_unless_confirmed(app, image_pair, tmp_path):
     from aarecovery import read_image
     from aarecovery.viewer.sources import PairSource
