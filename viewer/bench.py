@@ -16,7 +16,6 @@ import numpy as np
 import aarecovery
 
 from .app import ViewerApp
-from .settings import supported_modes
 from .sources import PairSource
 
 __all__ = ["run_bench", "make_bench_pair"]
@@ -85,12 +84,12 @@ def _slider_latencies(app):
     for index in range(_SLIDER_CHANGES):
         # Alternate between two points of the slider so that every press changes the value.
         x = left + (right - left) * (0.3 if index % 2 == 0 else 0.7)
-        before = app.recoveries
+        before = app.recovery.recoveries
         start = time.perf_counter()
         _press(app, x, y)
         for _ in range(_MAX_FRAMES_PER_CHANGE):
             _frame(app)
-            if app.recoveries > before:
+            if app.recovery.recoveries > before:
                 latencies.append(time.perf_counter() - start)
                 break
         _release(app, x, y)
@@ -117,25 +116,25 @@ def run_bench(original, filtered, filter_name, image_size, window_size):
         source = PairSource(original, filtered, None if filtered else filter_name or "threshold")
         app = ViewerApp(None, size=window_size, vsync=False)
         try:
-            if not app.open(source):
+            if not app.opener.open(source):
                 print(f"aarecovery view --bench: {app.messages[-1].text}")
                 return 1
             for _ in range(_WARM_UP_FRAMES):
                 _frame(app)
             renderer = app.context.info["GL_RENDERER"]
             fb_width, fb_height = glfw.get_framebuffer_size(app.window)
-            width, height = app.pair.size
+            width, height = app.recovery.pair.size
             print(f"renderer: {renderer}; window {fb_width}x{fb_height}; images {width}x{height}; "
                   f"{os.cpu_count()} CPUs")
             idle = _idle_frame_times(app)
             print(f"idle frame time ({len(idle)} frames): {_milliseconds(idle)} "
                   f"-> {1 / statistics.median(idle):.0f} frames per second")
             failed = False
-            for mode in supported_modes() or (None,):
-                app.settings = app.settings.with_values(mode=mode)
+            for mode in aarecovery.MODES:
+                app.recovery.settings = app.recovery.settings.with_values(mode=mode)
                 _frame(app)
                 latencies = _slider_latencies(app)
-                label = f"mode={mode}" if mode else "recovery"
+                label = f"mode={mode}"
                 if len(latencies) < _SLIDER_CHANGES:
                     print(f"slider-to-frame latency, {label}: {_SLIDER_CHANGES - len(latencies)} changes never showed")
                     failed = True

@@ -3,6 +3,8 @@
 import argparse
 import sys
 
+from aarecovery import PARAMETERS
+
 # Only the table of views: the GUI packages are imported inside run().
 from .keys import VIEW_MODES as _VIEW_NAMES
 
@@ -37,10 +39,9 @@ def register(subparsers):
     parser.add_argument("--filter", metavar="NAME", dest="filter_name",
                         help="built-in filter that makes F from ORIGINAL when FILTERED is not given "
                              "(see the panel's list; default posterize)")
-    parser.add_argument("--sigma-d", type=float, default=0.1, metavar="X", help="initial sigma_d (default %(default)s)")
-    parser.add_argument("--sigma-e", type=float, default=0.01, metavar="X", help="initial sigma_e (default %(default)s)")
-    parser.add_argument("--iterations", type=int, default=3, metavar="N",
-                        help="initial iteration count (default %(default)s)")
+    for spec in PARAMETERS.values():
+        parser.add_argument(spec.option, type=spec.kind, default=spec.default, metavar="N" if spec.kind is int else "X",
+                            help=f"initial {spec.label} ({spec.minimum:g} to {spec.maximum:g}, default %(default)s)")
     parser.add_argument("--view", choices=[mode for mode, _, _ in _VIEW_NAMES], default="result",
                         help="what the window shows first (keys 1 to 9 switch; default %(default)s)")
     parser.add_argument("--size", default="1280x720", metavar="WxH", help="window size (default %(default)s)")
@@ -75,15 +76,15 @@ def run(args):
         return 1
     from aarecovery import InputError
 
-    from .app import ViewerApp, WindowError, sample_source
+    from .app import ViewerApp, WindowError
     from .settings import RecoverySettings
-    from .sources import SAMPLE_FILTER, PairSource
+    from .sources import SAMPLE_FILTER, PairSource, sample_source
 
     window_size = _size(args.size, "--size")
     if args.filtered and args.filter_name:
         raise InputError("give either FILTERED or --filter, not both")
     settings = RecoverySettings.defaults().with_values(
-        sigma_d=args.sigma_d, sigma_e=args.sigma_e, iterations=args.iterations)
+        **{name: spec.check(getattr(args, name)) for name, spec in PARAMETERS.items()})
     if args.bench:
         from .bench import run_bench
         return run_bench(args.original, args.filtered, args.filter_name, _size(args.bench_size, "--bench-size"),
@@ -97,9 +98,9 @@ def run(args):
     except WindowError as error:
         raise InputError(str(error)) from None
     try:
-        app.set_view_mode(args.view)
+        app.comparison.set_view_mode(args.view)
         if source is None:
-            app.show_error("the bundled sample is not in this install; open files from the panel")
+            app.messages.error("the bundled sample is not in this install; open files from the panel")
         if args.screenshot:
             return _screenshot(app, args.screenshot)
         app.run()

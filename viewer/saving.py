@@ -1,10 +1,16 @@
-"""Saving R: where by default, and when to ask before replacing a file."""
+"""Saving R and sharing how it was made.
+
+Where R goes by default, when to ask before replacing a file, and the equivalent command
+line on the clipboard.
+"""
 
 import os
 
 import aarecovery
 
-__all__ = ["default_output_path", "overwrite_question", "save_result"]
+from .settings import command_line
+
+__all__ = ["default_output_path", "overwrite_question", "save_result", "SaveActions"]
 
 
 def default_output_path(source):
@@ -54,3 +60,78 @@ def save_result(engine, path, overwrite=False):
         When the disk refuses the write.
     """
     aarecovery.write_image(path, engine.result(), overwrite=overwrite)
+
+
+class SaveActions:
+    """Save R (asking before replacing a file) and copy the command line that makes it.
+
+    Parameters
+    ----------
+    panel : PanelState
+        Holds the save path and the pending questions.
+    recovery : LiveRecovery
+        The shown pair and the engine holding R.
+    messages : MessageLog
+    set_clipboard : callable
+        ``set_clipboard(text)``; the app passes ImGui's.
+    """
+
+    def __init__(self, panel, recovery, messages, set_clipboard):
+        self.panel = panel
+        self.recovery = recovery
+        self.messages = messages
+        self.set_clipboard = set_clipboard
+
+    def start(self):
+        """Open the save dialog (Ctrl+S)."""
+        if self.recovery.pair is None:
+            self.messages.error("nothing to save: open an image pair first")
+            return
+        self.panel.save_dialog_requested = True
+
+    def request(self, path):
+        """Save R to `path`, first asking if that replaces a file (an input most of all)."""
+        path = os.path.expanduser(path.strip())
+        if not path:
+            self.messages.error("give a file name to save R to")
+            return False
+        pair = self.recovery.pair
+        question = overwrite_question(path, pair.source if pair else None)
+        if question is not None:
+            self.panel.pending_overwrite = (path, question)
+            return False
+        return self._save(path, overwrite=False)
+
+    def confirm_overwrite(self):
+        """The user confirmed replacing the file of the pending save."""
+        if self.panel.pending_overwrite is None:
+            return False
+        path, self.panel.pending_overwrite = self.panel.pending_overwrite[0], None
+        return self._save(path, overwrite=True)
+
+    def _save(self, path, overwrite):
+        try:
+            self.recovery.update()
+            save_result(self.recovery.engine, path, overwrite=overwrite)
+        except (aarecovery.InputError, OSError) as error:
+            self.messages.error(f"not saved: {error}")
+            return False
+        self.messages.info(f"saved R to {path}")
+        return True
+
+    def command_line(self):
+        """The shell command that reproduces the shown R, or None without a pair."""
+        pair = self.recovery.pair
+        if pair is None:
+            return None
+        output = self.panel.save_path.strip() or default_output_path(pair.source)
+        return command_line(pair.source, self.recovery.settings, output)
+
+    def copy_command_line(self):
+        """Put :meth:`command_line` on the clipboard."""
+        text = self.command_line()
+        if text is None:
+            self.messages.error("open an image pair first")
+            return
+        self.set_clipboard(text)
+        self.messages.info("command line copied to the clipboard")

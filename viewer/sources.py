@@ -11,8 +11,8 @@ import numpy as np
 
 import aarecovery
 
-__all__ = ["PairSource", "LoadedPair", "load_pair", "sample_path", "filter_names", "filter_parameters",
-           "SAMPLE_FILTER"]
+__all__ = ["PairSource", "LoadedPair", "load_pair", "sample_path", "sample_source", "filter_names",
+           "filter_parameters", "SAMPLE_FILTER"]
 
 #: The filter applied to the bundled sample when no FILTERED file is given.
 SAMPLE_FILTER = "posterize"
@@ -64,6 +64,14 @@ def sample_path():
         if candidate.is_file():
             return os.fspath(candidate)
     return None
+
+
+def sample_source():
+    """The bundled sample and the sample filter, or None when the install has neither."""
+    path = sample_path()
+    if path is None or SAMPLE_FILTER not in filter_names():
+        return None
+    return PairSource(path, None, SAMPLE_FILTER, {})
 
 
 @dataclass

@@ -1,18 +1,23 @@
-"""The viewer's ImGui widgets: the side panel, messages, the help overlay and dialogs.
+"""The viewer's ImGui widgets: the side panel, messages, the help overlay, dialogs, the divider.
 
-Each function draws one part for one frame and changes the app only through its methods and
-plain attributes, so that the same actions are reachable from keys, widgets and tests.
+Each function draws one part for one frame and changes the app only through its parts'
+methods and plain attributes (``app.panel``, ``app.recovery.settings``, ``app.comparison``,
+``app.opener``, ``app.saving``), so that the same actions are reachable from keys, widgets
+and tests.
 """
 
 import os
 
 from imgui_bundle import imgui
 
-from . import settings as settings_module
-from .keys import KEY_HELP, VIEW_MODES
-from .sources import filter_names, filter_parameters
+import aarecovery
 
-__all__ = ["draw_ui", "PANEL_WIDTH"]
+from .keys import KEY_HELP, VIEW_MODES
+from .settings import RecoverySettings
+from .sources import filter_names, filter_parameters
+from .status import status_lines
+
+__all__ = ["draw_ui", "draw_divider", "PANEL_WIDTH"]
 
 #: Width of the side panel in window units (scaled with the content scale).
 PANEL_WIDTH = 330.0
@@ -20,6 +25,15 @@ PANEL_WIDTH = 330.0
 _ERROR = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 _INFO = imgui.ImVec4(0.6, 0.85, 1.0, 1.0)
 _DIM = imgui.ImVec4(0.65, 0.65, 0.65, 1.0)
+#: Range of the flicker period slider, in seconds.
+FLICKER_PERIODS = (0.1, 2.0)
+#: Range of the heat-map gain slider.
+HEAT_MAP_GAINS = (1.0, 64.0)
+# Slider values: three significant digits suit logarithmic ranges (ImGui rounds to them too).
+_FLOAT_FORMAT = "%.3g"
+# The value column of a slider is as wide as this text (the widest %.3g of the parameters'
+# ranges, 0.000123), or as the value if that is wider.
+_VALUE_COLUMN = "0.000000"
 _FIXED = (imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize | imgui.WindowFlags_.no_collapse
           | imgui.WindowFlags_.no_saved_settings)
 
@@ -36,10 +50,10 @@ def _record(app, name):
 
 def draw_ui(app):
     """Draw every window of one frame."""
-    if app.panel_visible:
+    if app.panel.visible:
         _panel(app)
     _messages(app)
-    if app.help_visible:
+    if app.panel.help_visible:
         _help(app)
     _dialogs(app)
 
@@ -59,13 +73,13 @@ def _panel(app):
 
 
 def _path_row(app, label, attribute, browse_role):
-    changed, value = imgui.input_text(f"##{attribute}", getattr(app, attribute))
+    changed, value = imgui.input_text(f"##{attribute}", getattr(app.panel, attribute))
     _record(app, attribute)
     if changed:
-        setattr(app, attribute, value)
+        setattr(app.panel, attribute, value)
     imgui.same_line()
-    if app.native_dialogs and imgui.button(f"...##{attribute}"):
-        app.browse(browse_role)
+    if app.dialogs.available and imgui.button(f"...##{attribute}"):
+        app.dialogs.browse(browse_role, app.panel)
     imgui.same_line()
     imgui.text(label)
 
@@ -73,61 +87,94 @@ def _path_row(app, label, attribute, browse_role):
 def _files_section(app):
     if not imgui.collapsing_header("Images", imgui.TreeNodeFlags_.default_open):
         return
-    _path_row(app, "ORIGINAL", "original_field", "original")
+    panel = app.panel
+    _path_row(app, "ORIGINAL", "original_path", "original")
     names = filter_names()
     if names:
-        if imgui.radio_button("FILTERED file", not app.use_builtin_filter):
-            app.use_builtin_filter = False
+        if imgui.radio_button("FILTERED file", not panel.use_builtin_filter):
+            panel.use_builtin_filter = False
         imgui.same_line()
-        if imgui.radio_button("built-in filter", app.use_builtin_filter):
-            app.use_builtin_filter = True
-    if app.use_builtin_filter and names:
-        index = names.index(app.filter_field) if app.filter_field in names else 0
+        if imgui.radio_button("built-in filter", panel.use_builtin_filter):
+            panel.use_builtin_filter = True
+    if panel.use_builtin_filter and names:
+        index = names.index(panel.filter_name) if panel.filter_name in names else 0
         changed, index = imgui.combo("filter", index, names)
         if changed:
-            app.choose_filter(names[index])
-        for name, default, help_text, is_int in filter_parameters(app.filter_field):
-            value = app.filter_params_field.get(name, default)
+            app.opener.choose_filter(names[index])
+        for name, default, help_text, is_int in filter_parameters(panel.filter_name):
+            value = panel.filter_params.get(name, default)
             if is_int:
                 _, value = imgui.input_int(name, int(value))
             else:
                 _, value = imgui.input_float(name, float(value), 0.0, 0.0, "%.4g")
             if imgui.is_item_hovered():
                 imgui.set_tooltip(help_text)
-            app.filter_params_field[name] = value
+            panel.filter_params[name] = value
             if imgui.is_item_deactivated_after_edit():
-                app.open_fields()
+                app.opener.open_fields()
     else:
-        _path_row(app, "FILTERED", "filtered_field", "filtered")
+        _path_row(app, "FILTERED", "filtered_path", "filtered")
     if imgui.button("Open (Ctrl+O)"):
-        app.open_fields()
+        app.opener.open_fields()
     _record(app, "open")
     imgui.same_line()
     imgui.text_colored(_DIM, "or drop files on the window")
 
 
+def _slider(app, key, label, value, minimum, maximum, display_format, flags=0, help_text=None):
+    """A slider with its value beside the track, where the grab cannot cover it.
+
+    ImGui draws a slider's value centred on the track, under which the grab passes and hid
+    digits. Here the frame draws nothing (ImGui shows no text after ``##``; ctrl+click
+    editing and the rounding of dragged values still use the format after it) and the value
+    is a text item between the track and the label, whose column fits the widest value.
+
+    Returns
+    -------
+    The new value (int when `minimum` is an int).
+    """
+    style = imgui.get_style()
+    start_x = imgui.get_cursor_pos_x()
+    width = imgui.calc_item_width()
+    spacing = style.item_inner_spacing.x
+    column = max(imgui.calc_text_size(_VALUE_COLUMN).x, imgui.calc_text_size(display_format % value).x)
+    imgui.set_next_item_width(max(1.0, width - column - spacing))
+    slide = imgui.slider_int if isinstance(minimum, int) else imgui.slider_float
+    _, value = slide(f"##{key}", value, minimum, maximum, "##" + display_format, flags)
+    _record(app, key)
+    hovered = imgui.is_item_hovered()
+    imgui.same_line(0, spacing)
+    imgui.text(display_format % value)
+    low, high = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+    app.widget_rects[f"{key} value"] = (low.x, low.y, high.x, high.y)
+    imgui.same_line(max(start_x + width + spacing, imgui.get_cursor_pos_x()))
+    imgui.text(label)
+    if help_text and (hovered or imgui.is_item_hovered()):
+        imgui.set_tooltip(help_text)
+    return value
+
+
+def _parameter_slider(app, spec, value):
+    """A slider over one parameter's valid range, with its label and help from ``PARAMETERS``."""
+    flags = imgui.SliderFlags_.always_clamp
+    if spec.logarithmic:
+        flags |= imgui.SliderFlags_.logarithmic
+    return _slider(app, spec.name, spec.label, value, spec.minimum, spec.maximum,
+                   "%d" if spec.kind is int else _FLOAT_FORMAT, flags, spec.help)
+
+
 def _parameters_section(app):
     if not imgui.collapsing_header("Recovery", imgui.TreeNodeFlags_.default_open):
         return
-    s = app.settings
-    clamp = imgui.SliderFlags_.always_clamp
-    _, sigma_d = imgui.slider_float("sigma_d", s.sigma_d, *settings_module.SIGMA_D_RANGE, "%.4f",
-                                    clamp | imgui.SliderFlags_.logarithmic)
-    _record(app, "sigma_d")
-    _, sigma_e = imgui.slider_float("sigma_e", s.sigma_e, *settings_module.SIGMA_E_RANGE, "%.5f",
-                                    clamp | imgui.SliderFlags_.logarithmic)
-    _record(app, "sigma_e")
-    _, iterations = imgui.slider_int("iterations", s.iterations, *settings_module.ITERATIONS_RANGE, "%d", clamp)
-    _record(app, "iterations")
-    mode = s.mode
-    modes = settings_module.supported_modes()
-    if modes:
-        changed, index = imgui.combo("mode", modes.index(mode) if mode in modes else 0, list(modes))
-        _record(app, "mode")
-        mode = modes[index]
-    app.settings = s.with_values(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode)
+    settings = app.recovery.settings
+    values = {name: _parameter_slider(app, spec, getattr(settings, name))
+              for name, spec in aarecovery.PARAMETERS.items()}
+    modes = list(aarecovery.MODES)
+    _, index = imgui.combo("mode", modes.index(settings.mode), modes)
+    _record(app, "mode")
+    app.recovery.settings = settings.with_values(mode=modes[index], **values)
     if imgui.button("Paper defaults"):
-        app.settings = settings_module.RecoverySettings.defaults()
+        app.recovery.settings = RecoverySettings.defaults()
     imgui.same_line()
     imgui.text_colored(_DIM, "ctrl+click a slider to type")
 
@@ -135,23 +182,24 @@ def _parameters_section(app):
 def _view_section(app):
     if not imgui.collapsing_header("View", imgui.TreeNodeFlags_.default_open):
         return
+    comparison = app.comparison
     labels = [label for _, label, _ in VIEW_MODES]
     keys = [key for key, _, _ in VIEW_MODES]
-    index = keys.index(app.view_mode)
+    index = keys.index(comparison.view_mode)
     changed, index = imgui.combo("view", index, [f"{i + 1}  {label}" for i, label in enumerate(labels)])
     _record(app, "view")
     if changed:
-        app.set_view_mode(keys[index])
-    if imgui.radio_button("compare with F", app.compare_with == "filtered"):
-        app.compare_with = "filtered"
+        comparison.set_view_mode(keys[index])
+    if imgui.radio_button("compare with F", comparison.compare_with == "filtered"):
+        comparison.compare_with = "filtered"
     imgui.same_line()
-    if imgui.radio_button("with O", app.compare_with == "original"):
-        app.compare_with = "original"
-    _, app.auto_flicker = imgui.checkbox("flicker (K)", app.auto_flicker)
-    imgui.same_line()
-    _, app.flicker_period = imgui.slider_float("##period", app.flicker_period, 0.1, 2.0, "every %.2f s")
-    _, app.difference_gain = imgui.slider_float("heat-map gain", app.difference_gain, 1.0, 64.0, "x%.1f",
-                                                imgui.SliderFlags_.logarithmic)
+    if imgui.radio_button("with O", comparison.compare_with == "original"):
+        comparison.compare_with = "original"
+    _, comparison.auto_flicker = imgui.checkbox("flicker (K)", comparison.auto_flicker)
+    comparison.flicker_period = _slider(app, "flicker_period", "flicker period", comparison.flicker_period,
+                                        *FLICKER_PERIODS, "%.2f s")
+    comparison.difference_gain = _slider(app, "difference_gain", "heat-map gain", comparison.difference_gain,
+                                         *HEAT_MAP_GAINS, "x%.1f", imgui.SliderFlags_.logarithmic)
     if imgui.button("Fit (F)"):
         app.view.fit()
     imgui.same_line()
@@ -165,18 +213,25 @@ def _actions_section(app):
     if not imgui.collapsing_header("Result", imgui.TreeNodeFlags_.default_open):
         return
     if imgui.button("Save R... (Ctrl+S)"):
-        app.start_save()
+        app.saving.start()
     _record(app, "save")
     imgui.same_line()
     if imgui.button("Copy command line"):
-        app.copy_command_line()
+        app.saving.copy_command_line()
     _record(app, "copy")
 
 
 def _status_section(app):
     imgui.separator()
-    for line in app.status_lines():
-        imgui.text_colored(_DIM, line)
+    imgui.push_text_wrap_pos(0.0)  # long lines wrap at the panel's edge
+    for line in status_lines(app):
+        imgui.text_colored(_DIM, line.text)
+        if line.detail and imgui.is_item_hovered() and imgui.begin_tooltip():
+            imgui.push_text_wrap_pos(imgui.get_font_size() * 35)
+            imgui.text_unformatted(line.detail)
+            imgui.pop_text_wrap_pos()
+            imgui.end_tooltip()
+    imgui.pop_text_wrap_pos()
     imgui.text_colored(_DIM, "H or F1: keys")
 
 
@@ -190,13 +245,13 @@ def _messages(app):
     imgui.set_next_window_size(imgui.ImVec2(max(200.0, width), 0))
     imgui.begin("##messages", None, _FIXED | imgui.WindowFlags_.no_title_bar
                 | imgui.WindowFlags_.always_auto_resize)
-    for index, message in enumerate(list(app.messages)):
+    for index, message in enumerate(app.messages):
         imgui.push_text_wrap_pos(imgui.get_cursor_pos_x() + width - 60)
         imgui.text_colored(_ERROR if message.error else _INFO, message.text)
         imgui.pop_text_wrap_pos()
         imgui.same_line()
         if imgui.small_button(f"x##message{index}"):
-            app.dismiss_message(message)
+            app.messages.dismiss(message)
     imgui.end()
 
 
@@ -217,16 +272,17 @@ def _help(app):
             imgui.end_table()
     imgui.end()
     if not still_open:
-        app.help_visible = False
+        app.panel.help_visible = False
 
 
 def _dialogs(app):
-    if app.open_save_dialog:
+    panel = app.panel
+    if panel.save_dialog_requested:
         imgui.open_popup("Save result")
-        app.open_save_dialog = False
-    if app.pending_overwrite is not None and not imgui.is_popup_open("Replace file?"):
+        panel.save_dialog_requested = False
+    if panel.pending_overwrite is not None and not imgui.is_popup_open("Replace file?"):
         imgui.open_popup("Replace file?")
-    if app.pending_drop is not None and not imgui.is_popup_open("Dropped file"):
+    if panel.pending_drop is not None and not imgui.is_popup_open("Dropped file"):
         imgui.open_popup("Dropped file")
 
     flags = imgui.WindowFlags_.always_auto_resize
@@ -235,43 +291,64 @@ def _dialogs(app):
         imgui.set_next_item_width(480)
         if imgui.is_window_appearing():
             imgui.set_keyboard_focus_here()
-        _, app.save_field = imgui.input_text("##save_path", app.save_field)
+        _, panel.save_path = imgui.input_text("##save_path", panel.save_path)
         imgui.text_colored(_DIM, "the extension picks the format: .png .tif .npy .jpg .webp .bmp")
         if imgui.button("Save") or imgui.is_key_pressed(imgui.Key.enter):
             imgui.close_current_popup()
-            app.request_save(app.save_field)
+            app.saving.request(panel.save_path)
         imgui.same_line()
-        if app.native_dialogs and imgui.button("Browse..."):
-            app.browse("save")
+        if app.dialogs.available and imgui.button("Browse..."):
+            app.dialogs.browse("save", panel)
         imgui.same_line()
         if imgui.button("Cancel") or imgui.is_key_pressed(imgui.Key.escape):
             imgui.close_current_popup()
         imgui.end_popup()
 
     if imgui.begin_popup_modal("Replace file?", None, flags)[0]:
-        question = app.pending_overwrite[1] if app.pending_overwrite else ""
+        question = panel.pending_overwrite[1] if panel.pending_overwrite else ""
         imgui.text_colored(_ERROR, question)
         if imgui.button("Replace"):
             imgui.close_current_popup()
-            app.confirm_overwrite()
+            app.saving.confirm_overwrite()
         imgui.same_line()
         if imgui.button("Cancel") or imgui.is_key_pressed(imgui.Key.escape):
             imgui.close_current_popup()
-            app.pending_overwrite = None
+            panel.pending_overwrite = None
         imgui.end_popup()
 
     if imgui.begin_popup_modal("Dropped file", None, flags)[0]:
-        name = os.path.basename(app.pending_drop or "")
+        name = os.path.basename(panel.pending_drop or "")
         imgui.text(f"Use {name} as:")
         if imgui.button("ORIGINAL"):
             imgui.close_current_popup()
-            app.use_dropped_as("original")
+            app.opener.use_dropped_as("original")
         imgui.same_line()
         if imgui.button("FILTERED"):
             imgui.close_current_popup()
-            app.use_dropped_as("filtered")
+            app.opener.use_dropped_as("filtered")
         imgui.same_line()
         if imgui.button("Cancel") or imgui.is_key_pressed(imgui.Key.escape):
             imgui.close_current_popup()
-            app.pending_drop = None
+            panel.pending_drop = None
         imgui.end_popup()
+
+
+# ---------------------------------------------------------------------------------- divider
+def draw_divider(app, area, scale):
+    """Draw the split view's divider, its handle and the names of the two sides."""
+    if app.comparison.view_mode != "split" or app.recovery.pair is None:
+        return
+    draw_list = imgui.get_background_draw_list()
+    x = (area[0] + app.view.split_x) / scale
+    height = area[3] / scale
+    draw_list.add_line(imgui.ImVec2(x, 0), imgui.ImVec2(x, height), imgui.IM_COL32(0, 0, 0, 160), 3.0)
+    draw_list.add_line(imgui.ImVec2(x, 0), imgui.ImVec2(x, height), imgui.IM_COL32(255, 255, 255, 230), 1.0)
+    handle_y = height / 2
+    draw_list.add_circle_filled(imgui.ImVec2(x, handle_y), 7.0, imgui.IM_COL32(255, 255, 255, 230))
+    left, right = app.comparison.side_names()
+    # Labels just below the handle, clear of the message strip at the top.
+    for text, label_x in ((left, x - 22), (right, x + 14)):
+        position = imgui.ImVec2(label_x, handle_y + 12)
+        draw_list.add_rect_filled(imgui.ImVec2(position.x - 3, position.y - 2),
+                                  imgui.ImVec2(position.x + 11, position.y + 15), imgui.IM_COL32(0, 0, 0, 160))
+        draw_list.add_text(position, imgui.IM_COL32(255, 255, 255, 255), text)

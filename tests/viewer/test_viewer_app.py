@@ -69,32 +69,37 @@ def centre(rect):
 def test_scripted_session(app, image_pair):
     import glfw
 
+    import aarecovery
     from aarecovery import read_image
     from aarecovery.viewer.sources import PairSource
 
-    assert app.open(PairSource(*image_pair))
+    assert app.opener.open(PairSource(*image_pair))
     frames(app, 3)
-    assert app.recoveries == 1 and app.computed[0] == app.settings
+    assert app.recovery.recoveries == 1 and app.recovery.computed[0] == app.recovery.settings
+    from aarecovery.viewer.status import plan_line, status_lines
+    assert plan_line(app.engine).text.startswith("safe: ") and plan_line(app.engine) in status_lines(app)
 
     # Slider drag: sigma_e from 30% to 80% of its (logarithmic) track.
     left, top, right, bottom = app.widget_rects["sigma_e"]
     y = (top + bottom) / 2
     drag(app, (left + 0.3 * (right - left), y), (left + 0.8 * (right - left), y))
-    # The track runs from 0.0005 to 0.5 logarithmically; its ends are inset by the grab's half width.
-    assert 0.0005 * 1000 ** 0.7 < app.settings.sigma_e < 0.0005 * 1000 ** 0.9
-    assert app.computed[0] == app.settings, "R is recomputed for the new value"
-    recoveries = app.recoveries
+    # The track spans sigma_e's valid range logarithmically; its ends are inset by the grab's half width.
+    spec = aarecovery.PARAMETERS["sigma_e"]
+    ratio = spec.maximum / spec.minimum
+    assert spec.minimum * ratio ** 0.7 < app.recovery.settings.sigma_e < spec.minimum * ratio ** 0.9
+    assert app.recovery.computed[0] == app.recovery.settings, "R is recomputed for the new value"
+    recoveries = app.recovery.recoveries
     frames(app, 3)
-    assert app.recoveries == recoveries, "nothing is recomputed while nothing changes"
+    assert app.recovery.recoveries == recoveries, "nothing is recomputed while nothing changes"
 
     # Keys: split view, 1:1 zoom.
     key(app, glfw.KEY_4)
-    assert app.view_mode == "split"
+    assert app.comparison.view_mode == "split"
     key(app, glfw.KEY_Z)
     assert app.view.zoom == 1
 
     # Divider drag to a quarter of the image area.
-    area, scale = app._area()
+    area, scale = app.image_area()
     divider_x = (area[0] + app.view.split_x) / scale
     target_x = (area[0] + 0.25 * area[2]) / scale
     drag(app, (divider_x, 300), (target_x, 300))
@@ -133,39 +138,143 @@ def test_scripted_session(app, image_pair):
 
     # Flicker swaps the sides; the heat-map shows |R - F|.
     key(app, glfw.KEY_SPACE)
-    assert app.side_names() == ("R", "F")
+    assert app.comparison.side_names() == ("R", "F")
     key(app, glfw.KEY_5)
-    assert app.view_mode == "difference"
+    assert app.comparison.view_mode == "difference"
     key(app, glfw.KEY_7)
-    assert app.view_mode == "beta" and app.computed[1], "map views compute the maps"
+    assert app.comparison.view_mode == "beta" and app.recovery.computed[1], "map views compute the maps"
 
     # Help overlay and the copied command line.
     key(app, glfw.KEY_H)
-    assert app.help_visible
+    assert app.panel.help_visible
     key(app, glfw.KEY_ESCAPE)
-    assert not app.help_visible
+    assert not app.panel.help_visible
     key(app, glfw.KEY_C, glfw.MOD_CONTROL | glfw.MOD_SHIFT)
     copied = glfw.get_clipboard_string(None).decode()
-    assert copied.startswith("aarecovery recover ") and f"--sigma-e {app.settings.sigma_e:g}" in copied
+    assert copied.startswith("aarecovery recover ") and f"--sigma-e {app.recovery.settings.sigma_e:g}" in copied
 
+
+def test_copied_command_line_reproduces_the_shown_result(app, image_pair, tmp_path):
+    import shlex
+
+    import glfw
+
+    import aarecovery
+    from aarecovery.cli import build_parser, main
+    from aarecovery.viewer.sources import PairSource
+
+    assert app.opener.open(PairSource(*image_pair))
+    frames(app, 3)
+    left, top, right, bottom = app.widget_rects["sigma_e"]
+    y = (top + bottom) / 2
+    drag(app, (left + 0.5 * (right - left), y), (left + 0.63 * (right - left), y))
+    assert app.recovery.settings.sigma_e != aarecovery.PARAMETERS["sigma_e"].default
+    for mode in aarecovery.MODES:
+        app.recovery.settings = app.recovery.settings.with_values(mode=mode)
+        app.panel.save_path = str(tmp_path / f"r-{mode}.png")
+        frames(app, 2)
+        assert app.recovery.computed[0].mode == mode
+        key(app, glfw.KEY_C, glfw.MOD_CONTROL | glfw.MOD_SHIFT)
+        words = shlex.split(glfw.get_clipboard_string(None).decode())
+        assert words[0] == "aarecovery"
+        build_parser().parse_args(words[1:])  # the real parser accepts it (exits otherwise)
+        assert main(words[1:]) == 0
+        np.testing.assert_array_equal(aarecovery.read_image(app.panel.save_path), app.engine.result(),
+                                      err_msg=f"mode {mode}")
+
+
+def test_view_refuses_parameters_out_of_range(capsys):
+    require_viewer_extra()
+    from aarecovery.cli import main
+    assert main(["view", "--sigma-e", "5"]) == 1
+    error = capsys.readouterr().err
+    assert error.startswith("aarecovery: error: sigma_e must be") and error.count("\n") == 1
+
+
+def _pixels_of_colour(shot, rgba):
+    target = np.rint(np.array([rgba.x, rgba.y, rgba.z]) * 255).astype(int)
+    return (np.abs(shot.astype(int) - target) <= 2).all(axis=-1)
+
+
+def test_slider_grab_never_covers_the_value(app, image_pair):
+    """Issue 13 item 8: the grab hid digits of the value drawn on the track."""
+    from imgui_bundle import imgui
+
+    import aarecovery
+    from aarecovery.viewer import ui
+    from aarecovery.viewer.sources import PairSource
+
+    assert app.opener.open(PairSource(*image_pair))
+    frames(app, 3)
+    style = imgui.get_style()  # the app's ImGui context is the current one
+
+    def set_parameter(name):
+        return lambda value: setattr(app.recovery, "settings", app.recovery.settings.with_values(**{name: value}))
+    sliders = {name: (spec.minimum, spec.maximum, spec.logarithmic, set_parameter(name))
+               for name, spec in aarecovery.PARAMETERS.items()}
+    sliders["flicker_period"] = (*ui.FLICKER_PERIODS, False, lambda v: setattr(app.comparison, "flicker_period", v))
+    sliders["difference_gain"] = (*ui.HEAT_MAP_GAINS, True, lambda v: setattr(app.comparison, "difference_gain", v))
+    for key, (low, high, logarithmic, set_value) in sliders.items():
+        middle = (low * high) ** 0.5 if logarithmic else (low + high) / 2
+        for value in (low, type(low)(middle), high):
+            set_value(value)
+            frames(app, 2)
+            app.step(capture=True)
+            track = [int(round(v)) for v in app.widget_rects[key]]
+            number = [int(round(v)) for v in app.widget_rects[f"{key} value"]]
+            band = app.last_screenshot[track[1]:track[3]]
+            grab = _pixels_of_colour(band, style.color_(imgui.Col_.slider_grab))
+            text = band.min(axis=-1) > 200  # ImGui's text is white; nothing else in the panel is
+            grab_columns = np.nonzero(grab.any(axis=0))[0]
+            where = f"{key} = {value}"
+            assert grab_columns.size and track[0] <= grab_columns[0] and grab_columns[-1] < track[2], where
+            assert not text[:, grab_columns[0]:grab_columns[-1] + 1].any(), f"text under the grab: {where}"
+            # The value: beside the track, inside the panel's clip rectangle, all of it drawn.
+            assert track[2] <= number[0] and number[2] <= app.panel_width - style.window_padding.x / 2, where
+            assert not grab[:, number[0]:number[2]].any(), where
+            drawn = np.nonzero(text[:, number[0]:number[2]].any(axis=0))[0]
+            assert drawn.size and drawn[0] <= 1 and drawn[-1] >= number[2] - number[0] - 2, where
+
+
+def test_ctrl_click_on_a_slider_types_its_value(app, image_pair):
+    import glfw
+
+    from aarecovery.viewer.sources import PairSource
+
+    assert app.opener.open(PairSource(*image_pair))
+    frames(app, 3)
+    app.platform.key_callback(app.window, glfw.KEY_LEFT_CONTROL, 0, glfw.PRESS, 0)
+    move(app, *centre(app.widget_rects["sigma_e"]))
+    frames(app, 1)
+    for action in (glfw.PRESS, glfw.RELEASE):
+        app.platform.mouse_button_callback(app.window, glfw.MOUSE_BUTTON_LEFT, action, glfw.MOD_CONTROL)
+        frames(app, 1)
+    app.platform.key_callback(app.window, glfw.KEY_LEFT_CONTROL, 0, glfw.RELEASE, glfw.MOD_CONTROL)
+    frames(app, 1)
+    for character in "0.0437":  # replaces the selected text of the field
+        app.platform.char_callback(app.window, ord(character))
+        frames(app, 1)
+    key(app, glfw.KEY_ENTER)
+    assert app.recovery.settings.sigma_e == pytest.approx(0.0437)
+    assert app.recovery.computed[0] == app.recovery.settings
 
 
 def test_saving_never_replaces_an_input_unless_confirmed(app, image_pair, tmp_path):
     from aarecovery import read_image
     from aarecovery.viewer.sources import PairSource
 
-    assert app.open(PairSource(*image_pair))
+    assert app.opener.open(PairSource(*image_pair))
     frames(app, 2)
     before = open(image_pair[1], "rb").read()
-    assert not app.request_save(image_pair[1])
-    assert app.pending_overwrite is not None and "FILTERED input" in app.pending_overwrite[1]
+    assert not app.saving.request(image_pair[1])
+    assert app.panel.pending_overwrite is not None and "FILTERED input" in app.panel.pending_overwrite[1]
     frames(app, 2)
     assert open(image_pair[1], "rb").read() == before, "nothing is written before the confirmation"
-    assert app.confirm_overwrite()
+    assert app.saving.confirm_overwrite()
     np.testing.assert_array_equal(read_image(image_pair[1]), app.engine.result())
 
     fresh = tmp_path / "fresh.png"
-    assert app.request_save(str(fresh))
+    assert app.saving.request(str(fresh))
     np.testing.assert_array_equal(read_image(fresh), app.engine.result())
 
 
@@ -179,16 +288,16 @@ def test_bad_input_shows_a_message_and_keeps_running(app, image_pair, tmp_path):
     from aarecovery import write_image
     from aarecovery.viewer.sources import PairSource
 
-    assert app.open(PairSource(*image_pair))
+    assert app.opener.open(PairSource(*image_pair))
     frames(app, 2)
-    shown = app.pair
+    shown = app.recovery.pair
 
     garbage = tmp_path / "garbage.png"
     garbage.write_bytes(b"\x89PNG\r\n\x1a\n this is not a PNG")
     app.platform.drop_callback(app.window, [str(garbage), image_pair[1]])
     frames(app, 3)
     assert app.messages and app.messages[-1].error and "garbage.png" in app.messages[-1].text
-    assert app.pair is shown
+    assert app.recovery.pair is shown
     app.step(capture=True)
     assert _error_pixels(app.last_screenshot) > 50, "the error is shown in the window"
 
@@ -197,14 +306,14 @@ def test_bad_input_shows_a_message_and_keeps_running(app, image_pair, tmp_path):
     app.platform.drop_callback(app.window, [image_pair[0], str(small)])
     frames(app, 2)
     assert "pixel for pixel" in app.messages[-1].text
-    assert app.pair is shown and app.step(), "the app keeps running and showing the last good pair"
-    assert app.computed is not None and app.computed[0] == app.settings
+    assert app.recovery.pair is shown and app.step(), "the app keeps running and showing the last good pair"
+    assert app.recovery.computed is not None and app.recovery.computed[0] == app.recovery.settings
 
     # A single dropped file asks what it is; used as FILTERED it is checked like the others.
     app.platform.drop_callback(app.window, [str(small)])
     frames(app, 2)
-    assert app.pending_drop == str(small)
-    assert not app.use_dropped_as("filtered")
+    assert app.panel.pending_drop == str(small)
+    assert not app.opener.use_dropped_as("filtered")
     assert "pixel for pixel" in app.messages[-1].text and app.step()
 
 

@@ -8,7 +8,7 @@ import pytest
 import aarecovery
 from aarecovery.cli import build_parser
 from aarecovery.viewer.saving import default_output_path, overwrite_question
-from aarecovery.viewer.settings import RecoverySettings, command_line, supported_modes
+from aarecovery.viewer.settings import MODE_OPTIONS, RecoverySettings, command_line
 from aarecovery.viewer.sources import PairSource, load_pair
 
 
@@ -29,12 +29,26 @@ def test_command_line_reproduces_the_parameters():
     assert (args.sigma_d, args.sigma_e, args.iterations) == (0.25, 0.02, 7)
 
 
-@pytest.mark.skipif(len(supported_modes()) < 2, reason="the engine has no mode switch")
-def test_command_line_selects_a_non_default_mode():
-    settings = RecoverySettings.defaults().with_values(mode=supported_modes()[1])
-    default = parse(command_line(PairSource("o.png", "f.png"), RecoverySettings.defaults(), "r.png"))[0]
-    changed = parse(command_line(PairSource("o.png", "f.png"), settings, "r.png"))[0]
-    assert vars(default) != vars(changed)
+def test_defaults_are_the_cores():
+    settings = RecoverySettings.defaults()
+    assert {name: getattr(settings, name) for name in aarecovery.PARAMETERS} == {
+        name: spec.default for name, spec in aarecovery.PARAMETERS.items()}
+    assert settings.mode == aarecovery.MODES[0]
+    (args,) = parse(command_line(PairSource("o.png", "f.png"), settings, "r.png"))
+    assert all(getattr(args, name) == spec.default for name, spec in aarecovery.PARAMETERS.items())
+
+
+@pytest.mark.parametrize("mode", aarecovery.MODES)
+def test_command_line_selects_every_mode(mode):
+    assert set(MODE_OPTIONS) == set(aarecovery.MODES)
+    settings = RecoverySettings.defaults().with_values(mode=mode)
+    (args,) = parse(command_line(PairSource("o.png", "f.png"), settings, "r.png"))
+    assert args.paper == (mode == "paper")
+
+
+def test_view_command_starts_at_the_cores_defaults():
+    args = build_parser().parse_args(["view"])
+    assert all(getattr(args, name) == spec.default for name, spec in aarecovery.PARAMETERS.items())
 
 
 def test_command_line_for_a_built_in_filter_writes_f_first():

@@ -1,0 +1,108 @@
+"""The panel's status lines: the pair, what the last recovery did, timings, zoom, the pixel.
+
+The plan line says what the engine's last run did (``Engine.last_plan``) in one short line,
+e.g. ``safe: point-wise filter on hard-edged content, full strength, blend in sRGB``; its
+tooltip is the plan's whole reason. The line is made of :data:`PLAN_PHRASES`, so a new
+figure of the last run is one more function there.
+"""
+
+import re
+from typing import NamedTuple, Optional
+
+from imgui_bundle import imgui
+
+from .view_input import window_to_view
+
+__all__ = ["StatusLine", "status_lines", "plan_line", "PLAN_PHRASES"]
+
+
+class StatusLine(NamedTuple):
+    """One status line and, optionally, more about it (shown as a tooltip)."""
+
+    text: str
+    detail: Optional[str] = None
+
+
+# A plan's reason reads "finding (figures): decision, ..."; its first clause, without the
+# figures, is what was found.
+_FIGURES = re.compile(r"\s*\([^()]*\)")
+_CLAUSE_END = re.compile(r"[:;,]")
+
+
+def _finding(engine):
+    """What the plan found: the first clause of its reason (``point-wise filter ...``)."""
+    return _CLAUSE_END.split(_FIGURES.sub("", engine.last_plan.reason), maxsplit=1)[0].strip() or None
+
+
+def _strength(engine):
+    strength = engine.last_plan.strength
+    if strength == 0:
+        return "F shown unchanged"
+    return "full strength" if strength == 1 else f"strength {strength:.2g}"
+
+
+def _blend_space(engine):
+    plan = engine.last_plan
+    if plan.strength == 0:
+        return None
+    return "blend in sRGB" if plan.blend_space == "srgb" else "blend in linear light"
+
+
+def _how_to_force(engine):
+    plan = engine.last_plan
+    if plan.strength == 0 and plan.mode != "paper":
+        return "switch to paper mode to force a repair"
+    return None
+
+
+#: The phrases of the plan line, in order. Each takes the engine after a run (its
+#: ``last_plan`` and whatever else it reports) and returns a short phrase, or None to say
+#: nothing. A new figure, such as the share of edge pixels repaired, is one more function here.
+PLAN_PHRASES = (_finding, _strength, _blend_space, _how_to_force)
+
+
+def plan_line(engine):
+    """What the engine's last run did, as one :class:`StatusLine`, or None before the first run.
+
+    Parameters
+    ----------
+    engine : aarecovery.Engine
+    """
+    if engine.last_plan is None:
+        return None
+    phrases = [phrase for phrase in (describe(engine) for describe in PLAN_PHRASES) if phrase]
+    return StatusLine(f"{engine.last_plan.mode}: {', '.join(phrases)}", engine.last_plan.reason)
+
+
+def status_lines(app):
+    """The status lines of one frame, top to bottom.
+
+    Parameters
+    ----------
+    app : ViewerApp
+
+    Returns
+    -------
+    list of StatusLine
+    """
+    engine = app.engine
+    pair = app.recovery.pair
+    lines = []
+    if pair is not None:
+        width, height = pair.size
+        lines.append(StatusLine(f"{width} x {height}  {pair.filtered.dtype}  backend {engine.backend}"))
+        plan = plan_line(engine)
+        if plan is not None:
+            lines.append(plan)
+        if engine.last_seconds is not None:
+            lines.append(StatusLine(f"last recovery {engine.last_seconds * 1000:.1f} ms"))
+        area, scale = app.image_area()
+        mouse = imgui.get_io().mouse_pos
+        pixel = app.view.pixel_at(*window_to_view(mouse.x, mouse.y, area, scale))
+        where = f"  pixel ({pixel[0]}, {pixel[1]})" if pixel else ""
+        lines.append(StatusLine(f"zoom {app.view.zoom * 100:.4g}%{where}"))
+    else:
+        lines.append(StatusLine(f"no images  backend {engine.backend}"))
+    if app.frame_seconds is not None:
+        lines.append(StatusLine(f"frame {app.frame_seconds * 1000:.1f} ms"))
+    return lines
