@@ -86,20 +86,6 @@ def add_parameter_options(parser):
                             help=f"{spec.help} ({spec.minimum:g} to {spec.maximum:g}, default %(default)s)")
 
 
-def _same_file(first, second):
-    if os.path.exists(first) and os.path.exists(second):
-        return os.path.samefile(first, second)
-    return os.path.realpath(first) == os.path.realpath(second)
-
-
-def _refuse_overwriting_inputs(outputs, inputs, allowed):
-    for output in outputs:
-        for role, source in inputs.items():
-            if not allowed and _same_file(output, source):
-                raise InputError(f"output {output} is the {role} image {source}; choose another output "
-                                 "name, or pass --overwrite to replace it")
-
-
 def _map_paths(folder):
     return {name: os.path.join(folder, f"{name}.png") for name in MAP_SCALES}
 
@@ -109,13 +95,6 @@ def _visible_map(values, scale):
 
     scaled = np.sqrt(np.maximum(values, 0)) if scale == "sqrt" else values * np.float32(scale)
     return np.rint(np.clip(scaled, 0, 1) * 65535).astype(np.uint16)
-
-
-def _write_maps(folder, maps):
-    from ..io import write_image
-
-    for name, path in _map_paths(folder).items():
-        write_image(path, _visible_map(getattr(maps, name), MAP_SCALES[name]))
 
 
 def _make_engine(backend):
@@ -136,10 +115,11 @@ def run(args):
     """Run ``aarecovery recover`` with parsed arguments; return the exit status."""
     import time
 
-    from ..io import check_output_path, read_image, write_image
+    from ..io import check_output_path, read_image, write_images
     from ..params import Parameters
     from ..pipeline import recover
     from ..tiling import check_tile_size
+    from .outputs import check_destinations, remove_stale_parts_of
 
     params = Parameters(args.sigma_d, args.sigma_e, args.iterations)
     if args.tile_size is not None:
@@ -151,7 +131,9 @@ def run(args):
         if os.path.exists(args.maps) and not os.path.isdir(args.maps):
             raise InputError(f"--maps {args.maps} is a file; give a folder to write the maps into")
         outputs += _map_paths(args.maps).values()
-    _refuse_overwriting_inputs(outputs, inputs, args.overwrite)
+    # Every destination before anything is read, computed or written.
+    check_destinations(outputs, inputs, overwrite=args.overwrite, folders=[args.maps] if args.maps else [])
+    remove_stale_parts_of(outputs)
 
     original = read_image(args.original)
     filtered = read_image(args.filtered)
@@ -169,15 +151,18 @@ def run(args):
         backend = engine.backend
     finally:
         engine.release()
+    images = {args.output: result}
     if args.maps is not None:
         result, maps = result
-        # Before the result, so that a folder that cannot be made stops the run with nothing written.
+        images = {args.output: result}
         os.makedirs(args.maps, exist_ok=True)
-    write_image(args.output, result)
+        for name, path in _map_paths(args.maps).items():
+            images[path] = _visible_map(getattr(maps, name), MAP_SCALES[name])
+    # All or none: a failure while writing any map leaves the result unwritten too.
+    write_images(images)
     message = (f"wrote {args.output} ({result.shape[1]}x{result.shape[0]}, {result.dtype}) "
                f"with the {backend} backend in {seconds:.2f} s")
     if args.maps is not None:
-        _write_maps(args.maps, maps)
         message += f"; maps in {args.maps}"
     print(message)
     return 0
