@@ -6,7 +6,10 @@ inside ``run`` so that ``aarecovery --help`` is instant.
 """
 
 import argparse
+import contextlib
+import signal
 import sys
+import threading
 
 from .. import __version__
 from ..errors import InputError
@@ -55,21 +58,54 @@ def build_parser():
     return parser
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP, raised where Python is running so that it unwinds like Ctrl+C:
+    ``write_image`` then removes its temporary file on the way out."""
+
+    def __init__(self, signum):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated(signum)
+
+
+@contextlib.contextmanager
+def _terminating_signals_interrupt():
+    """SIGTERM (a killed job) and SIGHUP (a closed terminal) interrupt like SIGINT while the
+    command runs. A signal already ignored (``nohup``) stays ignored."""
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        for name in ("SIGTERM", "SIGHUP"):
+            number = getattr(signal, name, None)
+            if number is not None and signal.getsignal(number) is not signal.SIG_IGN:
+                previous[number] = signal.signal(number, _raise_terminated)
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
 def main(argv=None):
-    """Run the command line; return the exit status (0 on success)."""
+    """Run the command line; return the exit status (0 on success, 128 + N after signal N)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if not hasattr(args, "run"):
         parser.print_help()
         return 2
     try:
-        return int(args.run(args) or 0)
+        with _terminating_signals_interrupt():
+            return int(args.run(args) or 0)
     except (InputError, OSError) as error:
         print(f"aarecovery: error: {error}", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print("aarecovery: interrupted; no output was written", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as interruption:
+        number = getattr(interruption, "signum", signal.SIGINT)
+        print(f"aarecovery: interrupted ({signal.Signals(number).name}); no half-written file was left",
+              file=sys.stderr)
+        return 128 + number
 
 
 if __name__ == "__main__":
