@@ -1,6 +1,6 @@
-"""The one exception type users catch for bad input."""
+"""The exception users catch for bad input, and the warnings aarecovery gives."""
 
-__all__ = ["InputError"]
+__all__ = ["InputError", "AarecoveryWarning", "BackendFallbackWarning", "OrderWarning"]
 
 
 class InputError(ValueError):
@@ -8,4 +8,19 @@ class InputError(ValueError):
 
     The message says what was wrong and how to fix it; the command line prints it
     as its one-line error.
+    """
+
+
+class AarecoveryWarning(UserWarning):
+    """Base of aarecovery's warnings; the command line prints each as one line."""
+
+
+class BackendFallbackWarning(AarecoveryWarning, RuntimeWarning):
+    """``backend="auto"`` found no OpenGL 3.3 and runs the NumPy backend (same result, slower)."""
+
+
+class OrderWarning(AarecoveryWarning):
+    """ORIGINAL and FILTERED look swapped: the image given as filtered has the antialiased edges.
+
+    ``aarecovery.plan.order`` decides it; the message is one line that says why.
     """

@@ -2,6 +2,7 @@
 
 import argparse
 import sys
+import warnings
 
 # Only the table of views: the GUI packages are imported inside run().
 from .keys import VIEW_MODES as _VIEW_NAMES
@@ -68,7 +69,7 @@ def _size(text, option):
 def run(args):
     """Open the viewer (or run --bench / --screenshot); returns the exit status."""
     try:
-        import glfw  # noqa: F401  (first: it decides which GLFW library loads)
+        import glfw  # (first: it decides which GLFW library loads)
         import imgui_bundle  # noqa: F401
     except ImportError:
         print(_MISSING, file=sys.stderr)
@@ -84,18 +85,25 @@ def run(args):
         raise InputError("give either FILTERED or --filter, not both")
     settings = RecoverySettings.defaults().with_values(
         sigma_d=args.sigma_d, sigma_e=args.sigma_e, iterations=args.iterations)
-    if args.bench:
-        from .bench import run_bench
-        return run_bench(args.original, args.filtered, args.filter_name, _size(args.bench_size, "--bench-size"),
-                         window_size)
-    if args.original:
-        source = PairSource(args.original, args.filtered, None if args.filtered else args.filter_name or SAMPLE_FILTER)
-    else:
-        source = sample_source()
-    try:
-        app = ViewerApp(source, settings=settings, size=window_size)
-    except WindowError as error:
-        raise InputError(str(error)) from None
+    # GLFW's own warnings repeat the reason that the one-line error gives (no GL 3.3 window).
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", glfw.GLFWError)
+        if args.bench:
+            from .bench import run_bench
+            try:
+                return run_bench(args.original, args.filtered, args.filter_name,
+                                 _size(args.bench_size, "--bench-size"), window_size)
+            except WindowError as error:
+                raise InputError(str(error)) from None
+        if args.original:
+            source = PairSource(args.original, args.filtered,
+                                None if args.filtered else args.filter_name or SAMPLE_FILTER)
+        else:
+            source = sample_source()
+        try:
+            app = ViewerApp(source, settings=settings, size=window_size)
+        except WindowError as error:
+            raise InputError(str(error)) from None
     try:
         app.set_view_mode(args.view)
         if source is None:

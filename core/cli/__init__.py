@@ -10,9 +10,10 @@ import contextlib
 import signal
 import sys
 import threading
+import warnings
 
 from .. import __version__
-from ..errors import InputError
+from ..errors import AarecoveryWarning, InputError
 from ..gimp import cli as gimp_command
 from ..viewer import cli as view_command
 from . import bench as bench_command
@@ -88,6 +89,23 @@ def _terminating_signals_interrupt():
             signal.signal(number, handler)
 
 
+@contextlib.contextmanager
+def _warnings_as_lines():
+    """aarecovery's own warnings as ``aarecovery: warning: ...``, each once per run."""
+    with warnings.catch_warnings():
+        shown = warnings.showwarning
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            if issubclass(category, AarecoveryWarning):
+                print(f"aarecovery: warning: {message}", file=sys.stderr, flush=True)
+            else:
+                shown(message, category, filename, lineno, file, line)
+
+        warnings.showwarning = show
+        warnings.filterwarnings("default", category=AarecoveryWarning)
+        yield
+
+
 def main(argv=None):
     """Run the command line; return the exit status (0 on success, 128 + N after signal N)."""
     parser = build_parser()
@@ -96,7 +114,7 @@ def main(argv=None):
         parser.print_help()
         return 2
     try:
-        with _terminating_signals_interrupt():
+        with _terminating_signals_interrupt(), _warnings_as_lines():
             return int(args.run(args) or 0)
     except (InputError, OSError) as error:
         print(f"aarecovery: error: {error}", file=sys.stderr)

@@ -2,7 +2,6 @@
 
 import argparse
 import os
-import sys
 
 # Already imported with the package; the codecs and the engine's backends load in run().
 from ..errors import InputError
@@ -97,24 +96,11 @@ def _visible_map(values, scale):
     return np.rint(np.clip(scaled, 0, 1) * 65535).astype(np.uint16)
 
 
-def _make_engine(backend):
-    import warnings
-
-    from ..engine import Engine
-
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", RuntimeWarning)
-        engine = Engine(backend)
-    for warning in caught:
-        # The fallback notice already reads "aarecovery: ...": one line, not a traceback frame.
-        print(f"{warning.message}", file=sys.stderr)
-    return engine
-
-
 def run(args):
     """Run ``aarecovery recover`` with parsed arguments; return the exit status."""
     import time
 
+    from ..engine import Engine
     from ..io import check_output_path, read_image, write_images
     from ..params import Parameters
     from ..pipeline import recover
@@ -140,7 +126,7 @@ def run(args):
     # Before the recovery, so that a long run does not end in a refusal.
     check_output_path(args.output, filtered.shape)
 
-    engine = _make_engine(args.backend)
+    engine = Engine(args.backend)
     try:
         start = time.perf_counter()
         result = recover(original, filtered, sigma_d=params.sigma_d, sigma_e=params.sigma_e,
