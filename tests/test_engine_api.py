@@ -135,3 +135,10 @@ def test_the_command_line_refuses_them_in_one_line(tmp_path, capsys, option, val
     assert len(err.splitlines()) == 1 and err.startswith("aarecovery: error: "), err
     assert option.lstrip("-").replace("-", "_") in err
     assert not (tmp_path / "r.png").exists()
+
+
+def test_a_black_original_under_a_gradient_map_is_recovered():
+    # Its analysis once met a singular matrix: a traceback instead of F back.
+    original = np.zeros((40, 50, 3), np.float32)
+    filtered = aarecovery.filters.apply("gradientmap", original)
+    np.testing.assert_array_equal(aarecovery.recover(original, filtered, backend="numpy"), filtered)
