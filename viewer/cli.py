@@ -1,6 +1,7 @@
 """``aarecovery view``: the interactive viewer (needs the ``viewer`` extra: glfw, imgui-bundle)."""
 
 import argparse
+import os
 import sys
 import warnings
 
@@ -45,6 +46,9 @@ def register(subparsers):
     parser.add_argument("--view", choices=[mode for mode, _, _ in _VIEW_NAMES], default="result",
                         help="what the window shows first (keys 1 to 9 switch; default %(default)s)")
     parser.add_argument("--size", default="1280x720", metavar="WxH", help="window size (default %(default)s)")
+    parser.add_argument("--max-image-memory", type=float, metavar="GB",
+                        help="largest decoded size of one image, checked before decoding (default: that of "
+                             "'aarecovery recover'); sets AARECOVERY_MAX_IMAGE_MEMORY for the session")
     parser.add_argument("--screenshot", metavar="PNG",
                         help="render a few frames, write the window's picture to PNG and exit")
     parser.add_argument("--bench", action="store_true",
@@ -80,6 +84,11 @@ def run(args):
     from .settings import RecoverySettings
     from .sources import SAMPLE_FILTER, PairSource
 
+    if args.max_image_memory is not None:
+        if not args.max_image_memory > 0:
+            raise InputError(f"--max-image-memory takes a positive number of GB, got {args.max_image_memory:g}")
+        # read_image's documented setting, for every image the session opens.
+        os.environ["AARECOVERY_MAX_IMAGE_MEMORY"] = str(args.max_image_memory)
     window_size = _size(args.size, "--size")
     if args.filtered and args.filter_name:
         raise InputError("give either FILTERED or --filter, not both")

@@ -7,6 +7,7 @@ import os
 from ..errors import InputError
 from ..params import BACKENDS, BLEND_SPACES, PARAMETERS
 from ..tiling import DEFAULT_TILES
+from .inputs import add_image_memory_option
 
 __all__ = ["register", "run", "MAP_SCALES"]
 
@@ -70,6 +71,7 @@ def register(subparsers):
     parser.add_argument("--overwrite", action="store_true",
                         help="allow OUTPUT to replace ORIGINAL or FILTERED (any other existing file "
                              "is always replaced)")
+    add_image_memory_option(parser)
     parser.add_argument("--tile-size", type=int, metavar="N",
                         help="largest tile side in pixels; larger images are processed in overlapping "
                              f"tiles with the same result (default: {DEFAULT_TILES['gl']} on GL, "
@@ -101,10 +103,11 @@ def run(args):
     import time
 
     from ..engine import Engine
-    from ..io import check_output_path, read_image, write_images
+    from ..io import check_output_path, write_images
     from ..params import Parameters
     from ..pipeline import recover
     from ..tiling import check_tile_size
+    from .inputs import check_pair_size, read_input
     from .outputs import check_destinations, remove_stale_parts_of
 
     params = Parameters(args.sigma_d, args.sigma_e, args.iterations)
@@ -121,8 +124,9 @@ def run(args):
     check_destinations(outputs, inputs, overwrite=args.overwrite, folders=[args.maps] if args.maps else [])
     remove_stale_parts_of(outputs)
 
-    original = read_image(args.original)
-    filtered = read_image(args.filtered)
+    original = read_input(args.original, args)
+    filtered = read_input(args.filtered, args)
+    check_pair_size(original, filtered, (args.original, args.filtered))
     # Before the recovery, so that a long run does not end in a refusal.
     check_output_path(args.output, filtered.shape)
 
