@@ -1,6 +1,6 @@
 """The exception users catch for bad input, and the warnings aarecovery gives."""
 
-__all__ = ["InputError", "AarecoveryWarning", "BackendFallbackWarning", "OrderWarning"]
+__all__ = ["InputError", "AarecoveryWarning", "BackendFallbackWarning", "OrderWarning", "TileSizeWarning"]
 
 
 class InputError(ValueError):
@@ -24,3 +24,7 @@ class OrderWarning(AarecoveryWarning):
 
     ``aarecovery.plan.order`` decides it; the message is one line that says why.
     """
+
+
+class TileSizeWarning(AarecoveryWarning):
+    """A ``tile_size`` so small that the run takes many times longer (``aarecovery.tiling``)."""

@@ -84,7 +84,7 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     if blend_space is not None:
         check_blend_space(blend_space)
     if tile_size is not None:
-        tile_size = check_tile_size(tile_size, parameters.iterations)
+        tile_size = check_tile_size(tile_size, parameters.iterations, image_size=f_layout.shape[:2])
     check_values(original, o_layout, "original")
     check_values(filtered, f_layout, "filtered")
     # Every decision on the whole image, before tiling, so that tiled == untiled.

@@ -94,11 +94,11 @@ def test_numpy_scalars_are_accepted(sigma_d, iterations):
 
 
 def test_numpy_scalars_reach_the_engine_and_tiles(backend):
-    original, filtered = edge_pair(size=(40, 44))
+    original, filtered = edge_pair(size=(100, 90))
     with aarecovery.Engine(backend) as engine:
         engine.set_images(original, filtered)
         result = engine.recover(sigma_d=np.float32(0.1), sigma_e=np.float16(0.01), iterations=np.int64(3))
-    tiled = aarecovery.recover(original, filtered, backend=backend, tile_size=np.int64(32),
+    tiled = aarecovery.recover(original, filtered, backend=backend, tile_size=np.int64(64),
                                sigma_d=np.float32(0.1), sigma_e=np.float16(0.01))
     np.testing.assert_array_equal(tiled, result)
 

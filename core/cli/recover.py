@@ -6,7 +6,7 @@ import os
 # Already imported with the package; the codecs and the engine's backends load in run().
 from ..errors import InputError
 from ..params import BACKENDS, BLEND_SPACES, PARAMETERS
-from ..tiling import DEFAULT_TILES
+from ..tiling import DEFAULT_TILES, SENSIBLE_TILE
 from .inputs import add_image_memory_option
 
 __all__ = ["register", "run", "MAP_SCALES"]
@@ -75,7 +75,7 @@ def register(subparsers):
     parser.add_argument("--tile-size", type=int, metavar="N",
                         help="largest tile side in pixels; larger images are processed in overlapping "
                              f"tiles with the same result (default: {DEFAULT_TILES['gl']} on GL, "
-                             f"{DEFAULT_TILES['numpy']} on NumPy)")
+                             f"{DEFAULT_TILES['numpy']} on NumPy; at least {SENSIBLE_TILE})")
     parser.set_defaults(run=run)
     return parser
 
