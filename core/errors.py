@@ -1,6 +1,7 @@
-"""The exception users catch for bad input, and the warnings aarecovery gives."""
+"""The exceptions users catch (bad input, not enough memory) and the warnings aarecovery gives."""
 
-__all__ = ["InputError", "AarecoveryWarning", "BackendFallbackWarning", "OrderWarning", "TileSizeWarning"]
+__all__ = ["InputError", "NotEnoughMemory", "AarecoveryWarning", "BackendFallbackWarning", "OrderWarning",
+           "TileSizeWarning"]
 
 
 class InputError(ValueError):
@@ -28,3 +29,7 @@ class OrderWarning(AarecoveryWarning):
 
 class TileSizeWarning(AarecoveryWarning):
     """A ``tile_size`` so small that the run takes many times longer (``aarecovery.tiling``)."""
+
+
+class NotEnoughMemory(MemoryError):
+    """Memory ran out; the message says how much the image needs and what to do (one line)."""

@@ -13,7 +13,7 @@ import threading
 import warnings
 
 from .. import __version__
-from ..errors import AarecoveryWarning, InputError
+from ..errors import AarecoveryWarning, InputError, NotEnoughMemory
 from ..gimp import cli as gimp_command
 from ..viewer import cli as view_command
 from . import bench as bench_command
@@ -118,6 +118,11 @@ def main(argv=None):
             return int(args.run(args) or 0)
     except (InputError, OSError) as error:
         print(f"aarecovery: error: {error}", file=sys.stderr)
+        return 1
+    except MemoryError as error:
+        # The core says how much it needed where it can (NotEnoughMemory); anything else is bare.
+        print(f"aarecovery: error: {str(error) or 'out of memory'}" + ("" if isinstance(error, NotEnoughMemory) else
+              "; try a smaller --tile-size, --backend numpy, or a machine with more memory"), file=sys.stderr)
         return 1
     except KeyboardInterrupt as interruption:
         number = getattr(interruption, "signum", signal.SIGINT)

@@ -10,7 +10,7 @@ import threading
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, NotEnoughMemory
 from .formats import NPY_DTYPES, READ_FORMATS, import_codec
 from .limits import check_decoded_size
 from .orientation import apply_orientation, png_header, tiff_orientation
@@ -123,6 +123,10 @@ def _checked_path(path):
 
 
 def _decode_error(path, format_name, error):
+    if isinstance(error, MemoryError):
+        # Not the file's fault: its declared size passed the limit, but this process has less.
+        return NotEnoughMemory(f"not enough memory to decode {path} as {format_name} ({str(error) or 'out of memory'}); "
+                               "close other programs, or use a machine with more memory")
     detail = str(error).strip() or type(error).__name__
     return InputError(f"could not decode {path} as {format_name}: {detail}; is the file complete?")
 
@@ -131,9 +135,9 @@ def _read_png(path, max_bytes):
     header = png_header(path)
     check_decoded_size(path, header.shape, header.dtype, max_bytes)
     imagecodecs = import_codec("imagecodecs", "PNG")
-    with open(path, "rb") as file:
-        data = file.read()
     try:
+        with open(path, "rb") as file:
+            data = file.read()
         # libpng expands palette, tRNS and sub-byte grey to 8 bits, so every PNG arrives as
         # one of the four layouts in 8 or 16 bits.
         image = imagecodecs.png_decode(data)

@@ -9,8 +9,9 @@ import shutil
 import numpy as np
 
 from ..contract import check_values, layout_of
-from ..errors import InputError
+from ..errors import InputError, NotEnoughMemory
 from .formats import NPY_DTYPES, WRITE_FORMATS, import_codec, layout_name
+from .limits import format_bytes
 from .parts import create_part
 
 __all__ = ["write_image", "write_images", "check_output_path", "check_writable_folder", "DiskError",
@@ -292,8 +293,13 @@ def _write_part(path, image, format_name):
         with open(temporary, "wb") as file:
             try:
                 _encode(file, pixels, format_name)
-            except (InputError, OSError, MemoryError):
+            except (InputError, OSError):
                 raise
+            except MemoryError as error:
+                reason = str(error) or "out of memory"
+                raise NotEnoughMemory(f"not enough memory to encode {path} as {format_name} ({reason}; the "
+                                      f"{pixels.dtype} {pixels.shape} image takes {format_bytes(pixels.nbytes)}); "
+                                      "close other programs, or write .tif or .npy, which encode with less") from None
             except Exception as error:
                 raise InputError(f"could not encode the {pixels.dtype} {pixels.shape} image as "
                                  f"{format_name}: {error}") from error
