@@ -5,15 +5,18 @@ tiles with a halo (``aarecovery.tiling``) -> load and run each tile in an Engine
 backend's passes) -> assemble the result in the filtered image's layout and dtype.
 """
 
+import warnings
+
 import numpy as np
 
 from .backends.base import RecoveryMaps
 from .contract import check_same_size, check_values, layout_of
 from .engine import Engine
-from .errors import NotEnoughMemory
+from .errors import NotEnoughMemory, OrderWarning
 from .memory import not_enough_memory
 from .params import DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, Parameters, check_blend_space, check_mode
 from .plan import make_plan
+from .plan.order import check_order
 from .tiling import DEFAULT_TILES, check_tile_size, halo_for, tiles
 
 __all__ = ["recover"]
@@ -69,6 +72,13 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     ------
     InputError
         On images or parameters the core cannot use; the message says how to fix them.
+    NotEnoughMemory
+        A MemoryError whose message says how much the pair needs and what to try.
+
+    Warns
+    -----
+    OrderWarning
+        When the pair looks given in the wrong order (:func:`aarecovery.check_order`).
 
     Examples
     --------
@@ -89,6 +99,9 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
         tile_size = check_tile_size(tile_size, parameters.iterations, image_size=f_layout.shape[:2])
     check_values(original, o_layout, "original")
     check_values(filtered, f_layout, "filtered")
+    order = check_order(original, filtered, linear=linear)
+    if order.looks_reversed:
+        warnings.warn(order.reason, OrderWarning, stacklevel=2)
     # Every decision on the whole image, before tiling, so that tiled == untiled.
     try:
         plan = make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space)

@@ -125,6 +125,7 @@ class ViewerApp:
         self.settings = settings or RecoverySettings.defaults()
         self.computed = None          # (settings, with maps) of the R in the engine's textures
         self.pair = None              # LoadedPair shown
+        self.order = None             # aarecovery.check_order's verdict on the pair shown
         self.view_mode = "result"
         self.compare_with = "filtered"
         self.swapped = False          # flicker state: show the comparison image instead of R
@@ -200,6 +201,9 @@ class ViewerApp:
         self.messages = [m for m in self.messages if not m.error]
         self.show_info(f"opened {os.path.basename(source.original)} and {source.describe_filtered()} "
                        f"({pair.size[0]}x{pair.size[1]})")
+        self.order = aarecovery.check_order(pair.original, pair.filtered)
+        if self.order.looks_reversed:
+            self.show_error(self.order.reason)
         return True
 
     def _reload_shown_pair(self):
@@ -531,6 +535,8 @@ class ViewerApp:
         if self.pair is not None:
             width, height = self.pair.size
             lines.append(f"{width} x {height}  {self.pair.filtered.dtype}  backend {self.engine.backend}")
+            if self.order is not None and self.order.looks_reversed:
+                lines.append("ORIGINAL and FILTERED look swapped")
             if self.engine.last_seconds is not None:
                 lines.append(f"last recovery {self.engine.last_seconds * 1000:.1f} ms")
             area, scale = self._area()
