@@ -25,8 +25,6 @@ examples:
   aarecovery view o.png f.png --screenshot shot.png save the first frames' picture and exit
 """
 
-_MISSING = "aarecovery view needs the viewer extra: pip install 'aarecovery[viewer]'"
-
 
 def register(subparsers):
     """Add the ``view`` subcommand to an argparse subparsers object."""
@@ -75,8 +73,9 @@ def run(args):
     try:
         import glfw  # (first: it decides which GLFW library loads)
         import imgui_bundle  # noqa: F401
-    except ImportError:
-        print(_MISSING, file=sys.stderr)
+    except ImportError as error:
+        from aarecovery.extras import missing_extra
+        print(f"aarecovery: error: {missing_extra('aarecovery view', 'viewer', error)}", file=sys.stderr)
         return 1
     from aarecovery import InputError
 

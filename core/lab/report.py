@@ -4,6 +4,7 @@ import os
 
 import numpy as np
 
+from ..extras import install_command
 from .evaluate import MAX_LOSS_DB, MIN_MEAN_REDUCTION, methods_of, summarize
 
 __all__ = ["format_table", "write_report"]
@@ -110,7 +111,7 @@ def write_report(results, folder, missing=(), command="aarecovery eval"):
         import matplotlib.pyplot as plt
     except ImportError:
         plt = None
-        lines += ["> Bar charts need matplotlib (`pip install aarecovery[eval]`); they were skipped.", ""]
+        lines += [f"> Bar charts need matplotlib (`{install_command('eval')}`); they were skipped.", ""]
     for name in dict.fromkeys(r.filter_name for r in results):
         picked = [r for r in results if r.filter_name == name]
         lines += [f"## {name}", ""]
