@@ -37,37 +37,30 @@ def _root_and_apt():
         pytest.skip("APT TESTS NOT RUN: " + message)
 
 
-def hold_locks(seconds):
-    holder = subprocess.Popen([sys.executable, "-c", _HOLDER, str(seconds), *LOCKS], stdout=subprocess.PIPE, text=True)
-    assert holder.stdout.readline() == "held\n"
-    return holder
-
-
-def run_script(lock_timeout):
-    env = {**os.environ, "AARECOVERY_APT_LOCK_TIMEOUT": str(lock_timeout), "AARECOVERY_APT_ATTEMPTS": "2"}
-    start = time.monotonic()
-    done = subprocess.run(["bash", str(SCRIPT), "coreutils"], capture_output=True, text=True, timeout=600, env=env)
-    return done, time.monotonic() - start
-
-
-def test_waits_for_locks_another_apt_holds():
-    holder = hold_locks(4)
+def run_script_while_locked(hold_seconds, lock_timeout):
+    """Run the script while another process holds apt's locks for `hold_seconds`."""
+    holder = subprocess.Popen([sys.executable, "-c", _HOLDER, str(hold_seconds), *LOCKS], stdout=subprocess.PIPE,
+                              text=True)
     try:
-        done, seconds = run_script(lock_timeout=120)
+        assert holder.stdout.readline() == "held\n"
+        env = {**os.environ, "AARECOVERY_APT_LOCK_TIMEOUT": str(lock_timeout), "AARECOVERY_APT_ATTEMPTS": "2"}
+        start = time.monotonic()
+        done = subprocess.run(["bash", str(SCRIPT), "coreutils"], capture_output=True, text=True, timeout=600,
+                              env=env)
+        return done, time.monotonic() - start
     finally:
         holder.kill()
         holder.wait()
+
+
+def test_waits_for_locks_another_apt_holds():
+    done, seconds = run_script_while_locked(4, lock_timeout=120)
     assert done.returncode == 0, done.stderr
     assert seconds >= 3.5
 
 
 def test_a_lock_held_too_long_fails_in_one_line():
-    holder = hold_locks(60)
-    try:
-        done, seconds = run_script(lock_timeout=3)
-    finally:
-        holder.kill()
-        holder.wait()
+    done, seconds = run_script_while_locked(60, lock_timeout=3)
     assert done.returncode == 1
     (line,) = done.stderr.splitlines()
     assert line.startswith("apt-install.sh: error: apt-get update failed")
