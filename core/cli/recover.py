@@ -124,14 +124,14 @@ def run(args):
     check_destinations(outputs, inputs, overwrite=args.overwrite, folders=[args.maps] if args.maps else [])
     remove_stale_parts_of(outputs)
 
-    original = read_input(args.original, args)
-    filtered = read_input(args.filtered, args)
-    check_pair_size(original, filtered, (args.original, args.filtered))
-    # Before the recovery, so that a long run does not end in a refusal.
-    check_output_path(args.output, filtered.shape)
-
+    # Before reading: a backend that cannot run (no OpenGL) says so at once.
     engine = Engine(args.backend)
     try:
+        original = read_input(args.original, args)
+        filtered = read_input(args.filtered, args)
+        check_pair_size(original, filtered, (args.original, args.filtered))
+        # Before the recovery, so that a long run does not end in a refusal.
+        check_output_path(args.output, filtered.shape)
         start = time.perf_counter()
         result = recover(original, filtered, sigma_d=params.sigma_d, sigma_e=params.sigma_e,
                          iterations=params.iterations, linear=args.linear, blend_space=args.blend_space,
@@ -141,10 +141,11 @@ def run(args):
         backend = engine.backend
     finally:
         engine.release()
-    images = {args.output: result}
+    maps = None
     if args.maps is not None:
         result, maps = result
-        images = {args.output: result}
+    images = {args.output: result}
+    if maps is not None:
         os.makedirs(args.maps, exist_ok=True)
         for name, path in _map_paths(args.maps).items():
             images[path] = _visible_map(getattr(maps, name), MAP_SCALES[name])
