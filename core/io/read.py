@@ -63,9 +63,7 @@ def read_image(path, *, max_bytes=None):
         format, mode or sample type this function does not read (the message says which
         ones it does), or larger once decoded than `max_bytes`.
     """
-    path = _checked_path(path)
-    with open(path, "rb") as file:
-        head = file.read(16)
+    path, head = _opened(path)
     if head.startswith(_PNG_SIGNATURE):
         image = _read_png(path, max_bytes)
     elif head.startswith(_TIFF_SIGNATURES):
@@ -87,9 +85,7 @@ def orientation_tag(path):
 
     For messages: :func:`read_image` has already applied it.
     """
-    path = _checked_path(path)
-    with open(path, "rb") as file:
-        head = file.read(16)
+    path, head = _opened(path)
     try:
         if head.startswith(_PNG_SIGNATURE):
             return png_header(path).orientation
@@ -106,7 +102,8 @@ def orientation_tag(path):
         return 1
 
 
-def _checked_path(path):
+def _opened(path):
+    """``(path, its first 16 bytes)``, or an InputError saying why the file cannot be read."""
     path = os.fspath(path)
     if not os.path.exists(path):
         raise InputError(f"{path} does not exist; check the file name")
@@ -119,7 +116,7 @@ def _checked_path(path):
         raise InputError(f"cannot read {path}: {error.strerror or error}; check its permissions") from None
     if not head:
         raise InputError(f"{path} is empty (0 bytes); is the file complete?")
-    return path
+    return path, head
 
 
 def _decode_error(path, format_name, error):
