@@ -16,11 +16,13 @@ __version__ = "0.1.0"
 
 from . import filters
 from .backends.base import RecoveryMaps
+from .backends import GLUnavailable
 from .engine import Engine
-from .errors import InputError
+from .errors import InputError, OrderWarning
 from .io import read_image, write_image
 from .params import BACKENDS, BLEND_SPACES, MODES, PARAMETERS
 from .pipeline import recover
+from .plan.order import check_order
 
-__all__ = ["recover", "Engine", "RecoveryMaps", "InputError", "read_image", "write_image", "filters",
-           "PARAMETERS", "BACKENDS", "MODES", "BLEND_SPACES", "__version__"]
+__all__ = ["recover", "check_order", "Engine", "RecoveryMaps", "InputError", "GLUnavailable", "OrderWarning",
+           "read_image", "write_image", "filters", "PARAMETERS", "BACKENDS", "MODES", "BLEND_SPACES", "__version__"]

@@ -38,6 +38,9 @@ class Engine:
 
     def __init__(self, backend="auto", *, context=None):
         self._impl = make_backend(backend, context)
+        self._released = False
+        # None, or {"maps": bool} once a run finished on the loaded pair.
+        self._computed = None
         self._layout = None
         self._pair = None
         self._loaded_space = None
@@ -87,11 +90,13 @@ class Engine:
         InputError
             On a shape, dtype, size mismatch, NaN or range the core cannot use.
         """
+        self._require_unreleased()
         o_layout = layout_of(original, "original")
         f_layout = layout_of(filtered, "filtered")
         check_same_size(o_layout, f_layout)
         if blend_space is not None:
             check_blend_space(blend_space)
+        self._computed = None
         self._layout = f_layout
         self._pair = (original, o_layout, filtered, f_layout, bool(linear), blend_space)
         self._analysis = None
@@ -99,12 +104,29 @@ class Engine:
 
     def _load(self, space):
         original, o_layout, filtered, f_layout, linear, _ = self._pair
+        self._computed = None
         self._impl.load(original, o_layout, filtered, f_layout, linear, space)
         self._loaded_space = space
 
+    # Every backend reaches the same states, and each call that needs a later one says which
+    # call comes first: before, NumPy raised a TypeError, GL returned black or the previous
+    # pair's result, and a released GL engine an AttributeError.
+    def _require_unreleased(self):
+        if self._released:
+            raise InputError("this engine was released; create a new aarecovery.Engine")
+
     def _require_images(self):
+        self._require_unreleased()
         if self._layout is None:
             raise InputError("no images loaded: call set_images(original, filtered) first")
+
+    def _require_computed(self, maps=False):
+        self._require_images()
+        if self._computed is None:
+            raise InputError("nothing computed for the loaded images: call "
+                             + ("compute(maps=True)" if maps else "compute() or recover()") + " first")
+        if maps and not self._computed["maps"]:
+            raise InputError("the last compute() kept no maps: call compute(maps=True) first")
 
     def plan(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
              mode=DEFAULT_MODE):
@@ -151,8 +173,10 @@ class Engine:
         if plan.blend_space != self._loaded_space:
             self._load(plan.blend_space)
         start = time.perf_counter()
+        self._computed = None
         self._impl.run(plan, maps)
         self._impl.finish()
+        self._computed = {"maps": bool(maps)}
         self.last_seconds = time.perf_counter() - start
         self.last_plan = plan
 
@@ -163,8 +187,13 @@ class Engine:
         -------
         ndarray
             Same shape and dtype as the `filtered` given to :meth:`set_images`.
+
+        Raises
+        ------
+        InputError
+            Before :meth:`set_images` and :meth:`compute`, and after :meth:`release`.
         """
-        self._require_images()
+        self._require_computed()
         return from_rgba_float(self._impl.read_result(), self._layout)
 
     def recover(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
@@ -179,8 +208,13 @@ class Engine:
         Returns
         -------
         RecoveryMaps
+
+        Raises
+        ------
+        InputError
+            When the last :meth:`compute` on the loaded pair did not keep maps.
         """
-        self._require_images()
+        self._require_computed(maps=True)
         return self._impl.read_maps()
 
     def texture(self, name="result"):
@@ -201,10 +235,19 @@ class Engine:
         if self.backend != "gl":
             raise InputError("textures exist only on the GL backend; create the engine with backend='gl'")
         self._require_images()
+        if name in RecoveryMaps.NAMES:
+            self._require_computed(maps=True)
         return self._impl.texture(name)
 
     def release(self):
-        """Free textures and programs (and the context, if the engine made it)."""
+        """Free textures and programs (and the context, if the engine made it); idempotent.
+
+        Every later call but :meth:`release` raises :class:`InputError`.
+        """
+        if self._released:
+            return
+        self._released = True
+        self._computed = None
         self._impl.release()
         self._layout = None
         self._pair = None

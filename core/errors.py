@@ -1,6 +1,7 @@
-"""The one exception type users catch for bad input."""
+"""The exceptions users catch (bad input, not enough memory) and the warnings aarecovery gives."""
 
-__all__ = ["InputError"]
+__all__ = ["InputError", "NotEnoughMemory", "AarecoveryWarning", "BackendFallbackWarning", "OrderWarning",
+           "TileSizeWarning"]
 
 
 class InputError(ValueError):
@@ -9,3 +10,26 @@ class InputError(ValueError):
     The message says what was wrong and how to fix it; the command line prints it
     as its one-line error.
     """
+
+
+class AarecoveryWarning(UserWarning):
+    """Base of aarecovery's warnings; the command line prints each as one line."""
+
+
+class BackendFallbackWarning(AarecoveryWarning, RuntimeWarning):
+    """``backend="auto"`` found no OpenGL 3.3 and runs the NumPy backend (same result, slower)."""
+
+
+class OrderWarning(AarecoveryWarning):
+    """ORIGINAL and FILTERED look swapped: the image given as filtered has the antialiased edges.
+
+    ``aarecovery.plan.order`` decides it; the message is one line that says why.
+    """
+
+
+class TileSizeWarning(AarecoveryWarning):
+    """A ``tile_size`` so small that the run takes many times longer (``aarecovery.tiling``)."""
+
+
+class NotEnoughMemory(MemoryError):
+    """Memory ran out; the message says how much the image needs and what to do (one line)."""

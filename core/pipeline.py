@@ -5,14 +5,19 @@ tiles with a halo (``aarecovery.tiling``) -> load and run each tile in an Engine
 backend's passes) -> assemble the result in the filtered image's layout and dtype.
 """
 
+import warnings
+
 import numpy as np
 
 from .backends.base import RecoveryMaps
 from .contract import check_same_size, check_values, layout_of
 from .engine import Engine
+from .errors import NotEnoughMemory, OrderWarning
+from .memory import not_enough_memory
 from .params import DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, Parameters, check_blend_space, check_mode
 from .plan import make_plan
-from .tiling import check_tile_size, halo_for, tiles
+from .plan.order import check_order
+from .tiling import DEFAULT_TILES, check_tile_size, halo_for, tiles
 
 __all__ = ["recover"]
 
@@ -67,6 +72,13 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     ------
     InputError
         On images or parameters the core cannot use; the message says how to fix them.
+    NotEnoughMemory
+        A MemoryError whose message says how much the pair needs and what to try.
+
+    Warns
+    -----
+    OrderWarning
+        When the pair looks given in the wrong order (:func:`aarecovery.check_order`).
 
     Examples
     --------
@@ -84,35 +96,54 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     if blend_space is not None:
         check_blend_space(blend_space)
     if tile_size is not None:
-        tile_size = check_tile_size(tile_size, parameters.iterations)
+        tile_size = check_tile_size(tile_size, parameters.iterations, image_size=f_layout.shape[:2])
     check_values(original, o_layout, "original")
     check_values(filtered, f_layout, "filtered")
+    order = check_order(original, filtered, linear=linear)
+    if order.looks_reversed:
+        warnings.warn(order.reason, OrderWarning, stacklevel=2)
     # Every decision on the whole image, before tiling, so that tiled == untiled.
-    plan = make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space)
-    if plan.keeps_filtered and not return_maps:
-        return filtered.copy()
+    try:
+        plan = make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space)
+        if plan.keeps_filtered and not return_maps:
+            return filtered.copy()
+    except MemoryError as error:
+        name = engine.backend if engine is not None else "gl" if backend == "auto" else backend
+        raise _out_of_memory(error, o_layout, f_layout, name, tile_size or DEFAULT_TILES[name], return_maps) from None
 
     own_engine = engine is None
     if own_engine:
         engine = Engine(backend)
+    tile = min(engine.capabilities.max_tile, tile_size or engine.capabilities.default_tile)
     try:
-        capabilities = engine.capabilities
-        tile = min(capabilities.max_tile, tile_size or capabilities.default_tile)
-        height, width = f_layout.height, f_layout.width
-        result = np.empty(f_layout.shape, f_layout.dtype)
-        maps = None
-        if return_maps:
-            maps = RecoveryMaps(*(np.empty((height, width), np.float32) for _ in RecoveryMaps.NAMES))
-        for inner, outer in tiles(height, width, tile, halo_for(plan.iterations)):
-            engine.set_images(original[outer], filtered[outer], linear=linear, blend_space=plan.blend_space)
-            engine.run(plan, maps=return_maps)
-            crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
-            result[inner] = engine.result()[crop]
-            if return_maps:
-                tile_maps = engine.maps()
-                for name in RecoveryMaps.NAMES:
-                    getattr(maps, name)[inner] = getattr(tile_maps, name)[crop]
+        return _recover_in_tiles(original, filtered, f_layout, plan, engine, tile, linear, return_maps)
+    except MemoryError as error:
+        raise _out_of_memory(error, o_layout, f_layout, engine.backend, tile, return_maps) from None
     finally:
         if own_engine:
             engine.release()
+
+
+def _out_of_memory(error, o_layout, f_layout, backend, tile, return_maps):
+    """One line with the figures, instead of a traceback from wherever the allocation failed."""
+    if isinstance(error, NotEnoughMemory):
+        return error
+    return not_enough_memory(o_layout, f_layout, backend, tile, return_maps, str(error))
+
+
+def _recover_in_tiles(original, filtered, f_layout, plan, engine, tile, linear, return_maps):
+    height, width = f_layout.height, f_layout.width
+    result = np.empty(f_layout.shape, f_layout.dtype)
+    maps = None
+    if return_maps:
+        maps = RecoveryMaps(*(np.empty((height, width), np.float32) for _ in RecoveryMaps.NAMES))
+    for inner, outer in tiles(height, width, tile, halo_for(plan.iterations)):
+        engine.set_images(original[outer], filtered[outer], linear=linear, blend_space=plan.blend_space)
+        engine.run(plan, maps=return_maps)
+        crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
+        result[inner] = engine.result()[crop]
+        if return_maps:
+            tile_maps = engine.maps()
+            for name in RecoveryMaps.NAMES:
+                getattr(maps, name)[inner] = getattr(tile_maps, name)[crop]
     return (result, maps) if return_maps else result

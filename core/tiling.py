@@ -7,10 +7,12 @@ rule for its row strips.
 """
 
 import numbers
+import warnings
 
-from .errors import InputError
+from .errors import InputError, TileSizeWarning
 
-__all__ = ["DEFAULT_TILES", "halo_for", "tiles", "smallest_tile", "check_tile_size"]
+__all__ = ["DEFAULT_TILES", "SENSIBLE_TILE", "halo_for", "tiles", "smallest_tile", "sensible_tile",
+           "check_tile_size"]
 
 #: The tile side each backend runs at by default, in pixels. NumPy: its passes hold about
 #: 40 float32 values per pixel at once, so 512 x 512 keeps a tile near 50 MB and in
@@ -19,6 +21,13 @@ __all__ = ["DEFAULT_TILES", "halo_for", "tiles", "smallest_tile", "check_tile_si
 #: peaks at 1.2 GB in all (4096 tiles: 1.9 GB, measured); larger tiles gained no speed on
 #: llvmpipe.
 DEFAULT_TILES = {"gl": 2048, "numpy": 512}
+#: The smallest tile side worth running. Each tile recomputes its halo and pays a fixed
+#: cost (an upload and a set of passes on GL). On a 768 x 512 pair, paper mode, 3
+#: iterations (halo 4), against the default tiles: GL 32 px 3.1x the time, 48 px 1.5x,
+#: 64 px 1.7x, 128 px 0.4x (one tile per 128 px strip, and noise); NumPy 32 px 3.6x, 48 px
+#: 2.0x, 64 px 1.5x, 128 px 1.0x; 16 px took 20x on GL and the issue measured 9 px at
+#: 282 s (GL) and 505 s (NumPy) where the default takes 0.1-0.3 s.
+SENSIBLE_TILE = 64
 
 
 def halo_for(iterations):
@@ -41,10 +50,22 @@ def smallest_tile(iterations):
     return 2 * halo_for(iterations) + 1
 
 
-def check_tile_size(tile_size, iterations, name="tile_size"):
+def sensible_tile(iterations):
+    """The smallest tile side worth running: :data:`SENSIBLE_TILE`, or 6 halos, whichever is more.
+
+    At 6 halos the interior is two thirds of the side, so a tile's halo costs at most
+    (6/4)^2 = 2.25 times the work of its interior (with many iterations the halo grows).
+    """
+    return max(SENSIBLE_TILE, 6 * halo_for(iterations))
+
+
+def check_tile_size(tile_size, iterations, name="tile_size", image_size=None):
     """Return `tile_size` as an int, or raise :class:`InputError` when it leaves no interior.
 
-    `name` is how the caller's user wrote it (``--tile-size`` on the command line).
+    `name` is how the caller's user wrote it. The command line (``name="--tile-size"``)
+    also refuses tiles below :func:`sensible_tile`, which only make a run take minutes; the
+    library warns (:class:`~aarecovery.errors.TileSizeWarning`) when an image of
+    `image_size` ``(height, width)`` would be cut into such tiles.
     """
     smallest = smallest_tile(iterations)
     if isinstance(tile_size, bool) or not isinstance(tile_size, numbers.Integral):
@@ -52,6 +73,15 @@ def check_tile_size(tile_size, iterations, name="tile_size"):
     if tile_size < smallest:
         raise InputError(f"{name} {tile_size} is too small for {iterations} iterations: each tile needs a "
                          f"{halo_for(iterations)}-pixel border on each side, so use at least {smallest}")
+    sensible = sensible_tile(iterations)
+    if tile_size < sensible:
+        why = (f"{name} {tile_size} is below {sensible}: tiles that small recompute their "
+               f"{halo_for(iterations)}-pixel borders and repeat their set-up so often that a run takes many "
+               "times longer for the same result")
+        if name.startswith("--"):
+            raise InputError(f"{why}; use at least {sensible}, or leave it out for the backend's default")
+        if image_size is not None and max(image_size) > tile_size:
+            warnings.warn(why, TileSizeWarning, stacklevel=3)
     return int(tile_size)
 
 

@@ -23,9 +23,8 @@ done
 if [ ${#missing[@]} -gt 0 ]; then
     if [ "$(id -u)" = 0 ]; then
         echo "test.sh: installing ${missing[*]}"
-        export DEBIAN_FRONTEND=noninteractive
-        apt-get update -qq
-        apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+        # Waits for apt's locks (busy right after boot) and retries the network, then one line.
+        bash packaging/apt-install.sh "${missing[@]}"
     else
         echo "test.sh: WARNING: not root, so these Debian packages cannot be installed: ${missing[*]}" >&2
         echo "test.sh: WARNING: the tests that need them will fail in CI or be skipped loudly" >&2

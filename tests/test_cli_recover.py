@@ -67,7 +67,7 @@ def test_parameters_reach_the_recovery(pair, capsys):
     folder, original, filtered = pair
     status, _, err = run_cli(capsys, folder / "o.png", folder / "f.png", "-o", folder / "r.tif",
                              "--sigma-d", 0.2, "--sigma-e", 0.02, "--iterations", 5,
-                             "--blend-space", "srgb", "--linear", "--tile-size", 16)
+                             "--blend-space", "srgb", "--linear", "--tile-size", 64)
     assert status == 0, err
     expected = aarecovery.recover(original, filtered, sigma_d=0.2, sigma_e=0.02, iterations=5,
                                   blend_space="srgb", linear=True, backend="numpy")
@@ -242,6 +242,8 @@ def test_alpha_result_to_jpeg_is_refused_before_recovery(tmp_path, capsys):
     ("--sigma-d", "nan", ("sigma_d", "nan")),
     ("--iterations", "65", ("iterations", "65")),
     ("--tile-size", "5", ("--tile-size 5", "at least 9")),
+    ("--tile-size", "9", ("--tile-size 9", "below 64", "at least 64")),
+    ("--tile-size", "63", ("--tile-size 63", "below 64")),
 ])
 def test_bad_parameters(pair, capsys, option, value, words):
     folder, _, _ = pair

@@ -117,3 +117,13 @@ def test_eval_command_runs(capsys):
     assert main(["eval", "--scenes", "star", "--filters", "posterize", "--width", "32", "--no-peers"]) == 0
     out = capsys.readouterr().out
     assert "== posterize" in out and "star" in out
+
+
+def test_the_summary_names_its_suite(quick, capsys):
+    results, missing, _ = quick
+    table = _report.format_table(results, missing, "the quick suite")
+    summary = [line for line in table.splitlines() if line.startswith("mean edge-band error reduction")]
+    assert len(summary) == 2 and all(" on the quick suite, " in line and "(paper " in line for line in summary)
+    from aarecovery.cli import main
+    assert main(["eval", "--no-peers", "--scenes", "text", "--filters", "threshold"]) == 0
+    assert "on a custom suite (1 scenes, 1 filters, 128 px, k=4)" in capsys.readouterr().out

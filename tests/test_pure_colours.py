@@ -61,6 +61,8 @@ def test_without_prior_the_fit_is_the_papers():
     assert model.pure_a is None and model.fixed_a is None
 
 
+# Small tiles on purpose: they put tile borders everywhere in a small image.
+@pytest.mark.filterwarnings("ignore::aarecovery.errors.TileSizeWarning")
 @pytest.mark.parametrize("iterations", [1, 3])
 def test_tiled_equals_untiled(backend, iterations):
     scene = _scenes.render("text", 48, 4)
@@ -73,6 +75,8 @@ def test_tiled_equals_untiled(backend, iterations):
     np.testing.assert_array_equal(tiled, whole)
 
 
+# Small tiles on purpose: they put tile borders everywhere in a small image.
+@pytest.mark.filterwarnings("ignore::aarecovery.errors.TileSizeWarning")
 def test_tiled_maps_equal_untiled(backend):
     case = thin_line_case()
     _, whole = aarecovery.recover(case.original, case.filtered, backend=backend, iterations=0, return_maps=True)

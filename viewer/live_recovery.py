@@ -42,6 +42,8 @@ class LiveRecovery:
         self.pair = None
         self.computed = None
         self.recoveries = 0
+        #: aarecovery.check_order's verdict on the pair shown (None before the first pair).
+        self.order = None
 
     def load(self, pair):
         """Load `pair` into the engine and show it from the next update.
@@ -54,6 +56,7 @@ class LiveRecovery:
         self.engine.set_images(pair.original, pair.filtered)
         self.pair = pair
         self.computed = None
+        self.order = aarecovery.check_order(pair.original, pair.filtered)
 
     def restore_shown_pair(self):
         """Put the shown pair back into the engine after a pair failed to load."""

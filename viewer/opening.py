@@ -55,6 +55,8 @@ class PairOpener:
         self.messages.clear_errors()
         self.messages.info(f"opened {os.path.basename(source.original)} and {source.describe_filtered()} "
                            f"({pair.size[0]}x{pair.size[1]})")
+        if self.recovery.order.looks_reversed:
+            self.messages.error(self.recovery.order.reason)
         return True
 
     def open_fields(self):

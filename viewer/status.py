@@ -94,6 +94,9 @@ def status_lines(app):
         plan = plan_line(engine)
         if plan is not None:
             lines.append(plan)
+        order = app.recovery.order
+        if order is not None and order.looks_reversed:
+            lines.append(StatusLine("ORIGINAL and FILTERED look swapped", order.reason))
         if engine.last_seconds is not None:
             lines.append(StatusLine(f"last recovery {engine.last_seconds * 1000:.1f} ms"))
         area, scale = app.image_area()

@@ -7,7 +7,7 @@ NumPy with a one-line warning when no OpenGL 3.3 context can be made.
 
 import warnings
 
-from ..errors import InputError
+from ..errors import BackendFallbackWarning, InputError
 from ..params import check_backend
 from .base import Backend, Capabilities, Plan, RecoveryMaps
 from .gl.context import GLUnavailable
@@ -53,6 +53,6 @@ def make_backend(name="auto", context=None):
     except GLUnavailable as error:
         if name == "gl":
             raise
-        warnings.warn(f"aarecovery: no OpenGL 3.3 context ({error}); using the NumPy backend", RuntimeWarning,
-                      stacklevel=3)
+        warnings.warn(f"no OpenGL 3.3 context ({error.reason}); using the NumPy backend (the same result, "
+                      "slower)", BackendFallbackWarning, stacklevel=3)
         return _numpy()

@@ -6,10 +6,15 @@ inside ``run`` so that ``aarecovery --help`` is instant.
 """
 
 import argparse
+import contextlib
+import signal
 import sys
+import threading
+import warnings
 
 from .. import __version__
-from ..errors import InputError
+from ..errors import AarecoveryWarning, InputError, NotEnoughMemory
+from ..extras import extra_for, missing_extra
 from ..gimp import cli as gimp_command
 from ..viewer import cli as view_command
 from . import bench as bench_command
@@ -52,24 +57,87 @@ def build_parser():
     subparsers = parser.add_subparsers(title="commands", metavar="COMMAND", parser_class=_Parser)
     for module in COMMANDS:
         module.register(subparsers)
+    for command in subparsers.choices.values():
+        command.set_defaults(prog=command.prog)
     return parser
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP, raised where Python is running so that it unwinds like Ctrl+C:
+    ``write_image`` then removes its temporary file on the way out."""
+
+    def __init__(self, signum):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated(signum)
+
+
+@contextlib.contextmanager
+def _terminating_signals_interrupt():
+    """SIGTERM (a killed job) and SIGHUP (a closed terminal) interrupt like SIGINT while the
+    command runs. A signal already ignored (``nohup``) stays ignored."""
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        for name in ("SIGTERM", "SIGHUP"):
+            number = getattr(signal, name, None)
+            if number is not None and signal.getsignal(number) is not signal.SIG_IGN:
+                previous[number] = signal.signal(number, _raise_terminated)
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+@contextlib.contextmanager
+def _warnings_as_lines():
+    """aarecovery's own warnings as ``aarecovery: warning: ...``, each once per run."""
+    with warnings.catch_warnings():
+        shown = warnings.showwarning
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            if issubclass(category, AarecoveryWarning):
+                print(f"aarecovery: warning: {message}", file=sys.stderr, flush=True)
+            else:
+                shown(message, category, filename, lineno, file, line)
+
+        warnings.showwarning = show
+        warnings.filterwarnings("default", category=AarecoveryWarning)
+        yield
+
+
 def main(argv=None):
-    """Run the command line; return the exit status (0 on success)."""
+    """Run the command line; return the exit status (0 on success, 128 + N after signal N)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if not hasattr(args, "run"):
         parser.print_help()
         return 2
     try:
-        return int(args.run(args) or 0)
+        with _terminating_signals_interrupt(), _warnings_as_lines():
+            return int(args.run(args) or 0)
+    except ImportError as error:
+        extra = extra_for(error)
+        if extra is None:
+            raise
+        print(f"aarecovery: error: {missing_extra(args.prog, extra, error)}", file=sys.stderr)
+        return 1
     except (InputError, OSError) as error:
         print(f"aarecovery: error: {error}", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print("aarecovery: interrupted; no output was written", file=sys.stderr)
-        return 130
+    except MemoryError as error:
+        # The core says how much it needed where it can (NotEnoughMemory); anything else is bare.
+        print(f"aarecovery: error: {str(error) or 'out of memory'}" + ("" if isinstance(error, NotEnoughMemory) else
+              "; try a smaller --tile-size, --backend numpy, or a machine with more memory"), file=sys.stderr)
+        return 1
+    except KeyboardInterrupt as interruption:
+        number = getattr(interruption, "signum", signal.SIGINT)
+        print(f"aarecovery: interrupted ({signal.Signals(number).name}); no half-written file was left",
+              file=sys.stderr)
+        return 128 + number
 
 
 if __name__ == "__main__":

@@ -4,6 +4,7 @@ import os
 import time
 
 from ..params import BACKENDS
+from .inputs import add_image_memory_option
 
 __all__ = ["register", "run"]
 
@@ -20,14 +21,15 @@ def register(subparsers):
     parser.add_argument("--backend", choices=BACKENDS, default="auto",
                         help="recovery backend (default auto)")
     parser.add_argument("--paper", action="store_true", help="the paper's method, without the safe default")
+    add_image_memory_option(parser)
     parser.set_defaults(run=run)
 
 
 def run(args):
     image = None
     if args.image:
-        from ..io import read_image
-        image = read_image(args.image)
+        from .inputs import read_input
+        image = read_input(args.image, args)
     from ..lab.demo import run_demo
 
     start = time.perf_counter()

@@ -65,14 +65,19 @@ def run(args):
     if width < 16:
         raise InputError(f"--width must be at least 16 pixels, got {width}")
     suite = Suite(scenes, filters, width, args.k or 4)
+    # The summary names the suite: the quick and full suites' figures differ, and one quoted
+    # without its suite cannot be compared.
+    name = "quick" if args.quick else "full"
+    label = (f"the {name} suite" if suite == Suite(base.scenes, base.filters, base.width, 4)
+             else f"a custom suite ({len(scenes)} scenes, {len(filters)} filters, {width} px, k={args.k or 4})")
     start = time.perf_counter()
     results, missing = run_suite(suite, backend=args.backend, peers=not args.no_peers,
                                  progress=sys.stderr.isatty(), keep_images=bool(args.report))
-    print(format_table(results, missing))
+    print(format_table(results, missing, label))
     print(f"\n{len(results)} cases in {time.perf_counter() - start:.1f} s")
     if args.report:
         command = "aarecovery eval" + (" --quick" if args.quick else "")
-        print(f"report: {write_report(results, args.report, missing, command)}")
+        print(f"report: {write_report(results, args.report, missing, command, label)}")
     return 0
 
 

@@ -5,6 +5,7 @@ import ast
 
 from ..errors import InputError
 from ..params import BACKENDS
+from .inputs import add_image_memory_option
 
 __all__ = ["register", "parse_params"]
 
@@ -34,6 +35,10 @@ def register(subparsers):
                                                              "without the safe default's safeguards")
     parser.add_argument("--backend", choices=BACKENDS, default="auto",
                         help="recovery backend (default auto)")
+    add_image_memory_option(parser)
+    parser.add_argument("--overwrite", action="store_true",
+                        help="allow OUTPUT to replace INPUT (the original that --recover, or a later "
+                             "'aarecovery recover', needs)")
     parser.set_defaults(run=_run_filter)
     listing = subparsers.add_parser("filters", help="list the test filters and their parameters",
                                     description="List the filters of 'aarecovery filter' with their parameters.")
@@ -81,17 +86,20 @@ def _run_list(args):
 
 def _run_filter(args):
     from .. import filters
-    from ..io import check_output_path, read_image, write_image
+    from ..io import write_image
+    from .inputs import read_input
+    from .outputs import check_destinations, remove_stale_parts_of
     spec = filters.get_filter(args.name)
     params = parse_params(args.param, spec)
-    check_output_path(args.output)
-    image = read_image(args.input)
+    if args.paper and not args.recover:
+        raise InputError("--paper only applies with --recover; add --recover or drop --paper")
+    check_destinations([args.output], {"input": args.input}, overwrite=args.overwrite)
+    remove_stale_parts_of([args.output])
+    image = read_input(args.input, args)
     filtered = filters.apply(spec.name, image, **params)
     if args.recover:
         from ..pipeline import recover
         filtered = recover(image, filtered, backend=args.backend, mode="paper" if args.paper else "safe")
-    elif args.paper:
-        raise InputError("--paper only applies with --recover; add --recover or drop --paper")
     write_image(args.output, filtered)
     print(f"wrote {args.output}")
     return 0

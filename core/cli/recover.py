@@ -2,12 +2,12 @@
 
 import argparse
 import os
-import sys
 
 # Already imported with the package; the codecs and the engine's backends load in run().
 from ..errors import InputError
 from ..params import BACKENDS, BLEND_SPACES, PARAMETERS
-from ..tiling import DEFAULT_TILES
+from ..tiling import DEFAULT_TILES, SENSIBLE_TILE
+from .inputs import add_image_memory_option
 
 __all__ = ["register", "run", "MAP_SCALES"]
 
@@ -71,10 +71,11 @@ def register(subparsers):
     parser.add_argument("--overwrite", action="store_true",
                         help="allow OUTPUT to replace ORIGINAL or FILTERED (any other existing file "
                              "is always replaced)")
+    add_image_memory_option(parser)
     parser.add_argument("--tile-size", type=int, metavar="N",
                         help="largest tile side in pixels; larger images are processed in overlapping "
                              f"tiles with the same result (default: {DEFAULT_TILES['gl']} on GL, "
-                             f"{DEFAULT_TILES['numpy']} on NumPy)")
+                             f"{DEFAULT_TILES['numpy']} on NumPy; at least {SENSIBLE_TILE})")
     parser.set_defaults(run=run)
     return parser
 
@@ -84,20 +85,6 @@ def add_parameter_options(parser):
     for spec in PARAMETERS.values():
         parser.add_argument(spec.option, type=spec.kind, default=spec.default, metavar="N" if spec.kind is int else "X",
                             help=f"{spec.help} ({spec.minimum:g} to {spec.maximum:g}, default %(default)s)")
-
-
-def _same_file(first, second):
-    if os.path.exists(first) and os.path.exists(second):
-        return os.path.samefile(first, second)
-    return os.path.realpath(first) == os.path.realpath(second)
-
-
-def _refuse_overwriting_inputs(outputs, inputs, allowed):
-    for output in outputs:
-        for role, source in inputs.items():
-            if not allowed and _same_file(output, source):
-                raise InputError(f"output {output} is the {role} image {source}; choose another output "
-                                 "name, or pass --overwrite to replace it")
 
 
 def _map_paths(folder):
@@ -111,35 +98,17 @@ def _visible_map(values, scale):
     return np.rint(np.clip(scaled, 0, 1) * 65535).astype(np.uint16)
 
 
-def _write_maps(folder, maps):
-    from ..io import write_image
-
-    for name, path in _map_paths(folder).items():
-        write_image(path, _visible_map(getattr(maps, name), MAP_SCALES[name]))
-
-
-def _make_engine(backend):
-    import warnings
-
-    from ..engine import Engine
-
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", RuntimeWarning)
-        engine = Engine(backend)
-    for warning in caught:
-        # The fallback notice already reads "aarecovery: ...": one line, not a traceback frame.
-        print(f"{warning.message}", file=sys.stderr)
-    return engine
-
-
 def run(args):
     """Run ``aarecovery recover`` with parsed arguments; return the exit status."""
     import time
 
-    from ..io import check_output_path, read_image, write_image
+    from ..engine import Engine
+    from ..io import check_output_path, write_images
     from ..params import Parameters
     from ..pipeline import recover
     from ..tiling import check_tile_size
+    from .inputs import check_pair_size, read_input
+    from .outputs import check_destinations, remove_stale_parts_of
 
     params = Parameters(args.sigma_d, args.sigma_e, args.iterations)
     if args.tile_size is not None:
@@ -151,15 +120,18 @@ def run(args):
         if os.path.exists(args.maps) and not os.path.isdir(args.maps):
             raise InputError(f"--maps {args.maps} is a file; give a folder to write the maps into")
         outputs += _map_paths(args.maps).values()
-    _refuse_overwriting_inputs(outputs, inputs, args.overwrite)
+    # Every destination before anything is read, computed or written.
+    check_destinations(outputs, inputs, overwrite=args.overwrite, folders=[args.maps] if args.maps else [])
+    remove_stale_parts_of(outputs)
 
-    original = read_image(args.original)
-    filtered = read_image(args.filtered)
-    # Before the recovery, so that a long run does not end in a refusal.
-    check_output_path(args.output, filtered.shape)
-
-    engine = _make_engine(args.backend)
+    # Before reading: a backend that cannot run (no OpenGL) says so at once.
+    engine = Engine(args.backend)
     try:
+        original = read_input(args.original, args)
+        filtered = read_input(args.filtered, args)
+        check_pair_size(original, filtered, (args.original, args.filtered))
+        # Before the recovery, so that a long run does not end in a refusal.
+        check_output_path(args.output, filtered.shape)
         start = time.perf_counter()
         result = recover(original, filtered, sigma_d=params.sigma_d, sigma_e=params.sigma_e,
                          iterations=params.iterations, linear=args.linear, blend_space=args.blend_space,
@@ -169,15 +141,19 @@ def run(args):
         backend = engine.backend
     finally:
         engine.release()
+    maps = None
     if args.maps is not None:
         result, maps = result
-        # Before the result, so that a folder that cannot be made stops the run with nothing written.
+    images = {args.output: result}
+    if maps is not None:
         os.makedirs(args.maps, exist_ok=True)
-    write_image(args.output, result)
+        for name, path in _map_paths(args.maps).items():
+            images[path] = _visible_map(getattr(maps, name), MAP_SCALES[name])
+    # All or none: a failure while writing any map leaves the result unwritten too.
+    write_images(images)
     message = (f"wrote {args.output} ({result.shape[1]}x{result.shape[0]}, {result.dtype}) "
                f"with the {backend} backend in {seconds:.2f} s")
     if args.maps is not None:
-        _write_maps(args.maps, maps)
         message += f"; maps in {args.maps}"
     print(message)
     return 0

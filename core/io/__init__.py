@@ -5,7 +5,11 @@ writes atomically in what the extension's format holds.
 """
 
 from .formats import WRITE_FORMATS
-from .read import MAX_PIXELS, read_image
-from .write import check_output_path, write_image
+from .limits import DEFAULT_MAX_BYTES, check_decoded_size
+from .parts import remove_stale_parts
+from .read import orientation_tag, read_image
+from .write import DiskError, check_output_path, check_writable_folder, write_image, write_images
 
-__all__ = ["read_image", "write_image", "check_output_path", "WRITE_FORMATS", "MAX_PIXELS"]
+__all__ = ["read_image", "write_image", "write_images", "check_output_path", "check_writable_folder",
+           "remove_stale_parts", "DiskError", "WRITE_FORMATS", "DEFAULT_MAX_BYTES", "check_decoded_size",
+           "orientation_tag"]

@@ -10,25 +10,26 @@ import threading
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, NotEnoughMemory
 from .formats import NPY_DTYPES, READ_FORMATS, import_codec
+from .limits import check_decoded_size
+from .orientation import apply_orientation, png_header, tiff_orientation
 
-__all__ = ["read_image", "MAX_PIXELS"]
+__all__ = ["read_image", "orientation_tag"]
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 _TIFF_SIGNATURES = (b"II*\x00", b"MM\x00*", b"II+\x00", b"MM\x00+")
 _NPY_SIGNATURE = b"\x93NUMPY"
 
 # Pillow refuses images above about 179 megapixels as possible decompression bombs; a 20000 x
-# 20000 scan is legitimate here. The limit below still stops a few-byte file that claims
-# 65535 x 65535 from allocating tens of gigabytes.
-MAX_PIXELS = 1 << 31
-# Pillow's limit is a module global; the lock keeps our own concurrent reads from restoring
-# each other's value out of order.
+# 20000 scan is legitimate here. Its check is switched off and ours (check_decoded_size, by
+# the bytes decoded) runs instead, with the same message as for every other format. Pillow's
+# limit is a module global; the lock keeps our own concurrent reads from restoring each
+# other's value out of order.
 _PILLOW_LIMIT_LOCK = threading.Lock()
 
 
-def read_image(path):
+def read_image(path, *, max_bytes=None):
     """Read an image file's pixels in the file's own bit depth and layout.
 
     The format is found from the file's first bytes, not its name.
@@ -39,6 +40,10 @@ def read_image(path):
         A PNG (8 or 16-bit), TIFF (8 or 16-bit integer, or 32-bit float; the first image of
         a multi-page file), NumPy ``.npy`` file, or anything else Pillow reads (JPEG, WebP,
         BMP, GIF, ...; the first frame), which is read as 8-bit.
+    max_bytes : int or float, optional
+        The most memory the decoded image may take, checked against the size the file
+        declares before anything is decoded. By default 4 GB, or the environment variable
+        ``AARECOVERY_MAX_IMAGE_MEMORY`` in GB (see ``aarecovery.io.limits`` for why).
 
     Returns
     -------
@@ -47,16 +52,58 @@ def read_image(path):
         uint16 as stored, float32 for float TIFF, and for ``.npy`` the stored uint8, uint16,
         float32 or float64. Palette images become RGB (RGBA where the palette has
         transparency), 1-bit images grey uint8 with values 0 and 255, CMYK RGB, 16-bit grey
-        Pillow modes (``I;16``) grey uint16. JPEG EXIF orientation is applied, so row 0 is
-        the top as viewers show it.
+        Pillow modes (``I;16``) grey uint16. The orientation a file declares (EXIF in JPEG,
+        WebP and PNG's ``eXIf`` chunk, the TIFF Orientation tag) is applied, so row 0 is the
+        top as viewers show it, in every format alike.
 
     Raises
     ------
     InputError
-        When the file is missing, a folder, unreadable, truncated or corrupt, empty, or in a
-        format, mode or sample type this function does not read; the message says which
-        ones it does.
+        When the file is missing, a folder, unreadable, truncated or corrupt, empty, in a
+        format, mode or sample type this function does not read (the message says which
+        ones it does), or larger once decoded than `max_bytes`.
     """
+    path, head = _opened(path)
+    if head.startswith(_PNG_SIGNATURE):
+        image = _read_png(path, max_bytes)
+    elif head.startswith(_TIFF_SIGNATURES):
+        image = _read_tiff(path, max_bytes)
+    elif head.startswith(_NPY_SIGNATURE):
+        image = _read_npy(path, max_bytes)
+    else:
+        image = _read_with_pillow(path, max_bytes)
+    if image.ndim == 3 and image.shape[2] == 1:
+        image = image[..., 0]
+    if 0 in image.shape:
+        raise InputError(f"{path} holds an empty image of shape {image.shape}; an image needs at least "
+                         "one row and one column")
+    return np.ascontiguousarray(image)
+
+
+def orientation_tag(path):
+    """The orientation `path` declares (EXIF / TIFF, 1 to 8; 1 when none), from its header only.
+
+    For messages: :func:`read_image` has already applied it.
+    """
+    path, head = _opened(path)
+    try:
+        if head.startswith(_PNG_SIGNATURE):
+            return png_header(path).orientation
+        if head.startswith(_TIFF_SIGNATURES):
+            tifffile = import_codec("tifffile", "TIFF")
+            with tifffile.TiffFile(path) as tif:
+                return tiff_orientation(tif.pages.first)
+        if head.startswith(_NPY_SIGNATURE):
+            return 1
+        from PIL import Image
+        with Image.open(path) as image:
+            return int(image.getexif().get(0x0112, 1))
+    except (InputError, OSError, ValueError, TypeError):
+        return 1
+
+
+def _opened(path):
+    """``(path, its first 16 bytes)``, or an InputError saying why the file cannot be read."""
     path = os.fspath(path)
     if not os.path.exists(path):
         raise InputError(f"{path} does not exist; check the file name")
@@ -69,40 +116,43 @@ def read_image(path):
         raise InputError(f"cannot read {path}: {error.strerror or error}; check its permissions") from None
     if not head:
         raise InputError(f"{path} is empty (0 bytes); is the file complete?")
-    if head.startswith(_PNG_SIGNATURE):
-        image = _read_png(path)
-    elif head.startswith(_TIFF_SIGNATURES):
-        image = _read_tiff(path)
-    elif head.startswith(_NPY_SIGNATURE):
-        image = _read_npy(path)
-    else:
-        image = _read_with_pillow(path)
-    if image.ndim == 3 and image.shape[2] == 1:
-        image = image[..., 0]
-    if 0 in image.shape:
-        raise InputError(f"{path} holds an empty image of shape {image.shape}; an image needs at least "
-                         "one row and one column")
-    return np.ascontiguousarray(image)
+    return path, head
 
 
 def _decode_error(path, format_name, error):
+    if isinstance(error, MemoryError):
+        # Not the file's fault: its declared size passed the limit, but this process has less.
+        return NotEnoughMemory(f"not enough memory to decode {path} as {format_name} ({str(error) or 'out of memory'}); "
+                               "close other programs, or use a machine with more memory")
     detail = str(error).strip() or type(error).__name__
     return InputError(f"could not decode {path} as {format_name}: {detail}; is the file complete?")
 
 
-def _read_png(path):
+def _read_png(path, max_bytes):
+    header = png_header(path)
+    check_decoded_size(path, header.shape, header.dtype, max_bytes)
     imagecodecs = import_codec("imagecodecs", "PNG")
-    with open(path, "rb") as file:
-        data = file.read()
     try:
+        with open(path, "rb") as file:
+            data = file.read()
         # libpng expands palette, tRNS and sub-byte grey to 8 bits, so every PNG arrives as
         # one of the four layouts in 8 or 16 bits.
-        return imagecodecs.png_decode(data)
+        image = imagecodecs.png_decode(data)
     except Exception as error:
         raise _decode_error(path, "PNG", error) from None
+    return apply_orientation(image, header.orientation)
 
 
-def _read_npy(path):
+def _read_npy(path, max_bytes):
+    try:
+        with open(path, "rb") as file:
+            version = np.lib.format.read_magic(file)
+            shape, _, dtype = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+                               else np.lib.format.read_array_header_2_0)(file)
+    except Exception as error:
+        raise _decode_error(path, "a NumPy .npy array", error) from None
+    if len(shape) in (2, 3) and not dtype.hasobject:
+        check_decoded_size(path, shape, dtype, max_bytes)
     try:
         array = np.load(path, allow_pickle=False)
     except Exception as error:
@@ -138,18 +188,27 @@ def _unpremultiply(data):
     return np.concatenate([np.where(alpha > 0, straight, 0).astype(data.dtype), alpha], axis=-1)
 
 
-def _read_tiff(path):
+def _read_tiff(path, max_bytes):
     tifffile = import_codec("tifffile", "TIFF")
     try:
         with tifffile.TiffFile(path) as tif:
             page = tif.pages.first
+            # Palette indices become RGB colours (of the colour map's depth, at most 16-bit).
+            shape = page.shape + ((3,) if page.photometric == tifffile.PHOTOMETRIC.PALETTE else ())
+            check_decoded_size(path, shape, np.uint16 if page.colormap is not None else page.dtype, max_bytes)
+            orientation = tiff_orientation(page)
             data = page.asarray()
-            axes, photometric = page.axes, page.photometric
-            extrasamples, colormap = tuple(page.extrasamples or ()), page.colormap
-            bits, compression = page.bitspersample, page.compression
+            layout = dict(axes=page.axes, photometric=page.photometric, extrasamples=tuple(page.extrasamples or ()),
+                          colormap=page.colormap, bits=page.bitspersample, compression=page.compression)
+    except InputError:
+        raise
     except Exception as error:
         raise _decode_error(path, "TIFF", error) from None
+    return apply_orientation(_tiff_pixels(path, data, tifffile, **layout), orientation)
 
+
+def _tiff_pixels(path, data, tifffile, axes, photometric, extrasamples, colormap, bits, compression):
+    """A TIFF page's samples as one of the four layouts, in 8/16-bit or float32."""
     # Bring the samples last (planar "separate" files store them first) and drop axes of
     # length 1; anything else is a stack or a volume, not one image.
     others = [length for length, axis in zip(data.shape, axes) if axis not in "YXS"]
@@ -216,12 +275,12 @@ _PILLOW_CONVERSIONS = {
 }
 
 
-def _read_with_pillow(path):
+def _read_with_pillow(path, max_bytes):
     from PIL import Image, ImageOps, UnidentifiedImageError
 
     with _PILLOW_LIMIT_LOCK:
         saved_limit = Image.MAX_IMAGE_PIXELS
-        # Checked below against MAX_PIXELS instead, with our own message.
+        # Checked in _pillow_pixels by check_decoded_size instead.
         Image.MAX_IMAGE_PIXELS = None
         try:
             try:
@@ -232,17 +291,35 @@ def _read_with_pillow(path):
             except Exception as error:
                 raise _decode_error(path, "an image", error) from None
             with image:
-                return _pillow_pixels(image, path, ImageOps)
+                return _pillow_pixels(image, path, ImageOps, max_bytes)
         finally:
             Image.MAX_IMAGE_PIXELS = saved_limit
 
 
-def _pillow_pixels(image, path, ImageOps):
-    format_name = image.format or "an image"
+def _pillow_decoded(image):
+    """The shape and dtype :func:`_pillow_pixels` returns for `image`, from its header."""
+    from PIL import ImageMode
+
     width, height = image.size
-    if width * height > MAX_PIXELS:
-        raise InputError(f"{path} claims {width}x{height} pixels, more than the {MAX_PIXELS} this reader "
-                         "accepts; split the image into parts first")
+    mode = image.mode
+    if mode.startswith("I;16") or mode == "I":
+        return (height, width), np.uint16
+    if mode == "F":
+        return (height, width), np.float32
+    if mode == "P":
+        converted = "RGBA" if "transparency" in image.info else "RGB"
+    else:
+        converted = _PILLOW_CONVERSIONS.get(mode) or mode
+    return (height, width, len(ImageMode.getmode(converted).bands)), np.uint8
+
+
+def _pillow_pixels(image, path, ImageOps, max_bytes):
+    format_name = image.format or "an image"
+    try:
+        shape, dtype = _pillow_decoded(image)
+    except (KeyError, ValueError):  # a mode Pillow itself does not describe: refused below
+        shape, dtype = (image.size[1], image.size[0], 4), np.uint8
+    check_decoded_size(path, shape, dtype, max_bytes)
     try:
         image.load()
         # In place: a copy would double the memory of a large JPEG.

@@ -1,15 +1,21 @@
 """Writing image files atomically, in the bit depth their format can hold."""
 
+import contextlib
+import errno
 import os
-import tempfile
+import re
+import shutil
 
 import numpy as np
 
 from ..contract import check_values, layout_of
-from ..errors import InputError
+from ..errors import InputError, NotEnoughMemory
 from .formats import NPY_DTYPES, WRITE_FORMATS, import_codec, layout_name
+from .limits import format_bytes
+from .parts import create_part
 
-__all__ = ["write_image", "check_output_path"]
+__all__ = ["write_image", "write_images", "check_output_path", "check_writable_folder", "DiskError",
+           "disk_error"]
 
 _JPEG_QUALITY = 95
 
@@ -60,6 +66,58 @@ def check_output_path(path, shape=None):
     return format_name
 
 
+class DiskError(OSError):
+    """The disk refused a write: one sentence that names the folder and says what to do."""
+
+    def __str__(self):
+        return self.strerror
+
+
+# ndarray.tofile (tifffile writes arrays with it) reports a short write without an errno.
+_SHORT_WRITE = re.compile(r"\d+ requested and \d+ written")
+
+
+def disk_error(error, folder, path=None):
+    """A :class:`DiskError` for an OSError met while writing `path` in `folder`.
+
+    The message names the folder, not the hidden temporary file, and says why: full,
+    read-only, no permission, or the system's own words.
+    """
+    code = error.errno
+    if code is None and _SHORT_WRITE.search(str(error)):
+        code = errno.ENOSPC
+    what = f"cannot write {path}" if path else f"cannot write into {folder}"
+    if code in (errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC)):
+        try:
+            free = f" ({shutil.disk_usage(folder).free / 1e6:.1f} MB free)"
+        except OSError:
+            free = ""
+        message = (f"{what}: the disk (or quota) holding {folder} is full{free}; free some space or "
+                   "write elsewhere")
+    elif code == errno.EROFS:
+        message = f"{what}: {folder} is on a read-only file system; choose a folder you can write to"
+    elif code in (errno.EACCES, errno.EPERM):
+        message = f"{what}: no permission to create files in {folder}; choose another folder or change its permissions"
+    else:
+        message = f"{what}: {error.strerror or error} (in {folder})"
+    return DiskError(code, message + " (nothing was written)" if path else message)
+
+
+def check_writable_folder(folder):
+    """Raise :class:`DiskError` unless a file can be created in `folder`.
+
+    Tried for real, with an empty part file that is removed at once: permissions alone do
+    not say it (root ignores them; a read-only mount or a full inode table does not show).
+    """
+    folder = os.fspath(folder)
+    try:
+        descriptor, probe = create_part(folder, "aarecovery-probe", ".tmp")
+    except OSError as error:
+        raise disk_error(error, folder) from None
+    os.close(descriptor)
+    os.unlink(probe)
+
+
 def _encoded_pixels(image, format_name):
     """Convert `image` to what `format_name` stores, per the table in :func:`write_image`."""
     layout = layout_of(image, "image")
@@ -85,7 +143,10 @@ def _encoded_pixels(image, format_name):
 
 def _encode(file, pixels, format_name):
     if format_name == "NPY":
-        np.save(file, pixels, allow_pickle=False)
+        # Header and data by file.write, not ndarray.tofile (what np.save does), whose short
+        # write on a full disk reports no errno.
+        np.lib.format.write_array_header_1_0(file, np.lib.format.header_data_from_array_1_0(pixels))
+        file.write(memoryview(np.ascontiguousarray(pixels)).cast("B"))
     elif format_name == "PNG":
         imagecodecs = import_codec("imagecodecs", "PNG")
         file.write(imagecodecs.png_encode(pixels))
@@ -175,40 +236,94 @@ def write_image(path, image, *, overwrite=True):
         On an unknown extension, a missing folder, an existing file with
         ``overwrite=False``, or an image the format cannot hold.
     OSError
-        When the disk refuses the write (full, read-only, no permission).
+        When the disk refuses the write; the message names the folder and why (full,
+        read-only, no permission), not the temporary file.
     """
-    path = os.fspath(path)
-    format_name = check_output_path(path, layout_of(image, "image").shape)
-    if not overwrite and os.path.lexists(path):
-        raise InputError(f"{path} already exists; choose another name or allow overwriting")
+    write_images({path: image}, overwrite=overwrite)
+
+
+def write_images(images, *, overwrite=True):
+    """Write several images as :func:`write_image` does, all or none of them.
+
+    Every image is first written completely to its temporary file; only then are they
+    renamed into place, so that a failure while writing any of them (a full disk, an
+    interruption) leaves every destination as it was.
+
+    Parameters
+    ----------
+    images : dict
+        ``{path: image}``.
+    overwrite : bool, optional
+        If False, refuse to replace existing files.
+    """
+    checked = []
+    for path, image in images.items():
+        path = os.fspath(path)
+        format_name = check_output_path(path, layout_of(image, "image").shape)
+        if not overwrite and os.path.lexists(path):
+            raise InputError(f"{path} already exists; choose another name or allow overwriting")
+        checked.append((path, image, format_name))
+    parts = []
+    try:
+        for path, image, format_name in checked:
+            parts.append(_write_part(path, image, format_name))
+        for _, temporary, path in parts:
+            _commit(temporary, path, overwrite)
+    except BaseException:
+        for _, temporary, _ in parts:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(temporary)
+        raise
+    finally:
+        for descriptor, _, _ in parts:
+            os.close(descriptor)
+
+
+def _write_part(path, image, format_name):
+    """Encode `image` into a new locked part beside `path`; return ``(descriptor, part, path)``."""
     pixels = _encoded_pixels(image, format_name)
     folder = os.path.dirname(os.path.abspath(path))
     name, extension = os.path.splitext(os.path.basename(path))
-    descriptor, temporary = tempfile.mkstemp(dir=folder, prefix=f".{name}.", suffix=".part" + extension)
     try:
-        os.close(descriptor)
+        descriptor, temporary = create_part(folder, name, extension)
+    except OSError as error:
+        raise disk_error(error, folder, path) from None
+    try:
         # Opened by name: tifffile needs a file object whose name is a path.
         with open(temporary, "wb") as file:
             try:
                 _encode(file, pixels, format_name)
             except (InputError, OSError):
                 raise
+            except MemoryError as error:
+                reason = str(error) or "out of memory"
+                raise NotEnoughMemory(f"not enough memory to encode {path} as {format_name} ({reason}; the "
+                                      f"{pixels.dtype} {pixels.shape} image takes {format_bytes(pixels.nbytes)}); "
+                                      "close other programs, or write .tif or .npy, which encode with less") from None
             except Exception as error:
                 raise InputError(f"could not encode the {pixels.dtype} {pixels.shape} image as "
                                  f"{format_name}: {error}") from error
             file.flush()
             os.fsync(file.fileno())
         os.chmod(temporary, _default_permissions(path))
+    except BaseException as error:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(temporary)
+        os.close(descriptor)
+        if isinstance(error, OSError) and not isinstance(error, DiskError):
+            raise disk_error(error, folder, path) from None
+        raise
+    return descriptor, temporary, path
+
+
+def _commit(temporary, path, overwrite):
+    try:
         if overwrite:
             os.replace(temporary, path)
         else:
             _link_without_replacing(temporary, path)
-    except BaseException:
-        try:
-            os.unlink(temporary)
-        except FileNotFoundError:
-            pass
-        raise
+    except OSError as error:
+        raise disk_error(error, os.path.dirname(os.path.abspath(path)), path) from None
 
 
 def _link_without_replacing(temporary, path):

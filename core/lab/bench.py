@@ -17,6 +17,7 @@ import time
 import numpy as np
 
 from ..colour import luma
+from ..errors import InputError
 
 __all__ = ["DEFAULT_SIZES", "bench_image_pair", "measure_throughput", "run_bench"]
 
@@ -147,8 +148,10 @@ def run_bench(sizes, backends, filters, runs, *, safe=False, memory=None, log=pr
     for name in backends:
         try:
             engines[name] = Engine(backend=name)
-        except Exception as error:  # a missing backend is reported, not fatal
-            log(f"{name}: not available ({error})")
+        except InputError as error:  # a missing backend is reported, not fatal while another runs
+            if len(backends) == 1 or (not engines and name == backends[-1]):
+                raise
+            log(f"{name}: not available: {error}")
     if "gl" in engines:
         info = engines["gl"].context.info
         report["gl_renderer"] = f"{info['GL_RENDERER']} / {info['GL_VERSION']}"

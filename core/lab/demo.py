@@ -91,13 +91,9 @@ def run_demo(image=None, folder="aarecovery-demo", *, backend="auto", paper=Fals
         ``{"folder", "sheet", "files", "gains"}``; gains maps each filter to
         ``(edge-band PSNR of F, of R)`` in dB, or None without a reference.
     """
-    from PIL import Image
-
-    from .. import filters
     from ..contract import layout_of, to_rgba_float
-    from ..pipeline import recover
+    from ..engine import Engine
     from ..plan.resample import box_downsample
-    from .metrics import edge_band, psnr
     from .scenes import sample_image
 
     if image is None:
@@ -110,14 +106,25 @@ def run_demo(image=None, folder="aarecovery-demo", *, backend="auto", paper=Fals
         original = box_downsample(scene, _K, "linear")
     else:
         original, scene = scene, None
+    # Before anything is written: a backend that cannot run stops the demo with no files made.
+    with Engine(backend) as engine:
+        return _write_demo(original, scene, folder, engine, "paper" if paper else "safe")
+
+
+def _write_demo(original, scene, folder, engine, mode):
+    from .. import filters
+    from ..io import write_image
+    from ..pipeline import recover
+    from ..plan.resample import box_downsample
+    from .metrics import edge_band, psnr
+
     os.makedirs(folder, exist_ok=True)
     files = [os.path.join(folder, "O.png")]
-    Image.fromarray(_to_uint8(original)).save(files[0])
+    write_image(files[0], _to_uint8(original))
     rows, gains = [], {}
-    mode = "paper" if paper else "safe"
     for name in DEMO_FILTERS:
         filtered = filters.apply(name, original)
-        recovered = recover(original, filtered, backend=backend, mode=mode)
+        recovered = recover(original, filtered, engine=engine, mode=mode)
         reference = None
         if scene is not None:
             params = filters.FILTERS[name].defaults()
@@ -128,11 +135,11 @@ def run_demo(image=None, folder="aarecovery-demo", *, backend="auto", paper=Fals
             gains[name] = None
         for label, picture in (("F", filtered), ("R", recovered)):
             files.append(os.path.join(folder, f"{label}-{name}.png"))
-            Image.fromarray(_to_uint8(picture)).save(files[-1])
+            write_image(files[-1], _to_uint8(picture))
         rows.append((name, [original, filtered, recovered, reference],
                      _inset_box(filtered, reference, original)))
     columns = ["O (original)", "F (filtered)", "R (recovered)", "reference (4x supersampled)"]
     sheet_path = os.path.join(folder, "sheet.png")
-    _sheet(rows, columns).save(sheet_path)
+    write_image(sheet_path, np.asarray(_sheet(rows, columns)))
     files.append(sheet_path)
     return {"folder": folder, "sheet": sheet_path, "files": files, "gains": gains}

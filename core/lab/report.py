@@ -4,13 +4,18 @@ import os
 
 import numpy as np
 
+from ..extras import install_command
 from .evaluate import MAX_LOSS_DB, MIN_MEAN_REDUCTION, methods_of, summarize
 
 __all__ = ["format_table", "write_report"]
 
 
-def format_table(results, missing=()):
-    """Plain-text tables, one per filter, and the summary: what ``aarecovery eval`` prints."""
+def format_table(results, missing=(), suite=None):
+    """Plain-text tables, one per filter, and the summary: what ``aarecovery eval`` prints.
+
+    `suite` names the suite in the summary lines (``"the quick suite"``): its figures differ
+    from another suite's, and a figure quoted without it cannot be compared.
+    """
     methods = methods_of(results)
     lines = []
     for peer in missing:
@@ -45,7 +50,8 @@ def format_table(results, missing=()):
     for space, values in summary["mean_reduction"].items():
         verdict = "ok" if values["R"] >= MIN_MEAN_REDUCTION else "FAILED"
         paper = f" (paper {values['paper']:.3f})" if "paper" in values else ""
-        lines.append(f"mean edge-band error reduction, synthetic, {space} antialiasing, blur excluded: "
+        lines.append(f"mean edge-band error reduction{f' on {suite}' if suite else ''}, synthetic, {space} "
+                     "antialiasing, blur excluded: "
                      f"R {values['R']:.3f}{paper}; target {MIN_MEAN_REDUCTION}: {verdict}")
     return "\n".join(lines)
 
@@ -75,7 +81,7 @@ def _crop_strip(result, methods, zoom=6):
     return np.concatenate(pieces[:-1], axis=1)
 
 
-def write_report(results, folder, missing=(), command="aarecovery eval"):
+def write_report(results, folder, missing=(), command="aarecovery eval", suite=None):
     """Write ``report.md`` with tables, bar charts (matplotlib, optional) and magnified crops.
 
     Parameters
@@ -87,6 +93,8 @@ def write_report(results, folder, missing=(), command="aarecovery eval"):
     missing : list of Peer
     command : str
         The command line, quoted in the report.
+    suite : str, optional
+        The suite's name for the summary lines (:func:`format_table`).
 
     Returns
     -------
@@ -102,7 +110,7 @@ def write_report(results, folder, missing=(), command="aarecovery eval"):
                      "it is missing from every table and chart.")
     lines += ["", "Columns: F (the filtered image), R (the safe default), paper (Yang et al. 2011 exactly)"
               + "".join(f", {m}" for m in methods if m in ("gimp", "gmic")) + ". All numbers are against the "
-              "supersampled reference; the band is the edge band.", "", "```", format_table(results, missing), "```",
+              "supersampled reference; the band is the edge band.", "", "```", format_table(results, missing, suite), "```",
               ""]
     try:
         import matplotlib
@@ -110,7 +118,7 @@ def write_report(results, folder, missing=(), command="aarecovery eval"):
         import matplotlib.pyplot as plt
     except ImportError:
         plt = None
-        lines += ["> Bar charts need matplotlib (`pip install aarecovery[eval]`); they were skipped.", ""]
+        lines += [f"> Bar charts need matplotlib (`{install_command('eval')}`); they were skipped.", ""]
     for name in dict.fromkeys(r.filter_name for r in results):
         picked = [r for r in results if r.filter_name == name]
         lines += [f"## {name}", ""]

@@ -54,9 +54,10 @@ def fit_lowpass(original, filtered):
     if spread < 1e-6:
         return False, 1.0, None
     # Normal equations: a 25 x 25 solve, ten times faster than lstsq's SVD here; the tiny
-    # ridge only matters for flat images, whose columns are all alike.
+    # ridge only matters for flat images, whose columns are all alike (and all zero for a
+    # black O, hence the absolute term: a gradient map of black O was a singular matrix).
     gram = design.T @ design
-    gram[np.diag_indices_from(gram)] += 1e-9 * np.trace(gram)
+    gram[np.diag_indices_from(gram)] += 1e-9 * np.trace(gram) + 1e-12
     weights = np.linalg.solve(gram, design.T @ target)
     residual = float(np.linalg.norm(design @ weights - target) / spread)
     kernel = weights.reshape(2 * r + 1, 2 * r + 1)

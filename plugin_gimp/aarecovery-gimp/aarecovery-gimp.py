@@ -50,6 +50,8 @@ def read_config():
         return {}
     return data if isinstance(data, dict) else {}
 
+ORDER_MARK = "order: "
+
 
 # ---------------------------------------------------------------------------------------------
 # The part shared by both ways of running the core. It needs NumPy and aarecovery, nothing of
@@ -73,7 +75,10 @@ def recover_arrays(original, filtered, params):
         warnings.simplefilter("always")
         engine = aarecovery.Engine(backend=params.pop("backend"))
         result = aarecovery.recover(original, filtered, engine=engine, **params)
-    messages = [str(w.message) for w in caught]
+    # An order warning (the original layer looks like the filtered one) is marked for a message
+    # of its own; the rest (the GL fallback) goes to the status bar.
+    messages = [(ORDER_MARK if issubclass(w.category, aarecovery.OrderWarning) else "") + str(w.message)
+                for w in caught]
     return np.ascontiguousarray(result, dtype=np.float32), engine.backend, messages
 
 
@@ -582,9 +587,13 @@ def recover_layer(procedure_name, image, layer, config):
         fmt, o, o_shape, f, f_shape, params = grab(image, procedure_name, layer, config)
         data, backend, where, messages, folders = run_core(o, o_shape, f, f_shape, params, config)
         write_pixels(layer, fmt, data)
-        if messages:
+        for message in messages:
+            if message.startswith(ORDER_MARK):
+                Gimp.message(f"aarecovery: {message[len(ORDER_MARK):]}")
+        notes = [message for message in messages if not message.startswith(ORDER_MARK)]
+        if notes:
             # The GL fallback note goes to the status bar, not a dialog: the result is right.
-            Gimp.progress_set_text(f"aarecovery: {messages[-1]}")
+            Gimp.progress_set_text(f"aarecovery: {notes[-1]}")
     finally:
         image.undo_group_end()
         Gimp.progress_end()

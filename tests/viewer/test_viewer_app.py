@@ -333,4 +333,5 @@ def test_missing_extra_message(monkeypatch, capsys):
     from aarecovery.cli import main
     monkeypatch.setitem(sys.modules, "imgui_bundle", None)  # as if the extra were not installed
     assert main(["view"]) == 1
-    assert "pip install 'aarecovery[viewer]'" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "needs the viewer extra" in err and "[viewer]'" in err

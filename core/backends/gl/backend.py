@@ -211,6 +211,15 @@ class GLBackend:
 
     def _allocate(self, size, o_dtype, o_channels, f_dtype, f_channels):
         self._release_images()
+        try:
+            self._allocate_images(size, o_dtype, o_channels, f_dtype, f_channels)
+        except moderngl.Error as error:
+            # Out of memory shows in the driver as a texture or framebuffer it cannot make
+            # ("the framebuffer is not complete" on llvmpipe, measured under prlimit).
+            self._release_images()
+            raise MemoryError(f"the GL driver could not make the {size[0]}x{size[1]} textures: {error}") from None
+
+    def _allocate_images(self, size, o_dtype, o_channels, f_dtype, f_channels):
         t = self._textures
         t["original"] = self._texture(size, o_channels, _texture_dtype(o_dtype))
         t["original"].swizzle = _SWIZZLES[o_channels]

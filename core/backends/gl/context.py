@@ -2,13 +2,25 @@
 
 import moderngl
 
+from ...errors import InputError
+
 __all__ = ["GLUnavailable", "create_context", "REQUIRED_VERSION"]
 
 REQUIRED_VERSION = 330
 
 
-class GLUnavailable(RuntimeError):
-    """No usable OpenGL 3.3 context could be created."""
+class GLUnavailable(InputError, RuntimeError):
+    """No usable OpenGL 3.3 context could be created.
+
+    An :class:`~aarecovery.InputError` (the backend asked for cannot be used here), so that
+    every interface shows it as its one-line error; `reason` holds the drivers' own words.
+    """
+
+    def __init__(self, reason):
+        super().__init__(f"no OpenGL 3.3 context here ({reason}); use the NumPy backend (--backend numpy, "
+                         "backend='numpy': the same result, slower), or install an OpenGL 3.3 driver "
+                         "(Debian and Ubuntu: apt-get install libegl1 libgl1-mesa-dri)")
+        self.reason = reason
 
 
 def create_context():
