@@ -227,3 +227,25 @@ def test_pure_colour_decisions_agree_where_a_neighbour_sits_exactly_on_the_ridge
     _, actual = aarecovery.recover(original, filtered, engine=gl_engine, iterations=1, return_maps=True)
     for name in aarecovery.RecoveryMaps.NAMES:
         np.testing.assert_allclose(getattr(actual, name), getattr(expected, name), rtol=0, atol=1e-4, err_msg=name)
+
+
+@pytest.mark.parametrize("weights", ["LUMA", "LUMINANCE_D50"])
+def test_luminance_keyed_tables_agree(gl_engine, weights):
+    """Thresholds of the encoded luminance of linear light, as GEGL and GIMP compute it: the
+    table is keyed by that luminance (table keys 4 and 5) on both backends, and the inks
+    are taken from O's flat colours where they lie beyond a thin feature."""
+    from aarecovery import colour
+    from aarecovery.lab.scenes import render
+    from aarecovery.plan.resample import box_downsample
+    original = np.rint(box_downsample(render("text", 64, 4), 4, "linear") * 255).astype(np.uint8)
+    linear = colour.srgb_to_linear(original / np.float32(255))
+    luminance = colour.linear_to_srgb(linear @ np.array(getattr(colour, weights), np.float32))
+    filtered = np.repeat(np.where(luminance >= 0.5, 255, 0).astype(np.uint8)[..., None], 3, axis=-1)
+    gl_engine.set_images(original, filtered)
+    gl_engine.compute()
+    # On this grey-inked text the two weightings tie; either luminance key (4, 5) will do.
+    assert gl_engine.last_plan.pure_colours.key in ("luminance", "luminance_d50")
+    actual = gl_engine.result()
+    expected = aarecovery.recover(original, filtered, backend="numpy")
+    assert np.abs(actual.astype(np.int64) - expected).max() <= 1
+    assert np.abs(expected.astype(np.int64) - filtered).max() > 16

@@ -18,6 +18,7 @@ TWINS = {
     ("pure_colours.glsl", "RANGE_TOLERANCE"): pure_colours.RANGE_TOLERANCE,
     ("pure_colours.glsl", "END_TOLERANCE"): pure_colours.END_TOLERANCE,
     ("pure_colours.glsl", "MIN_CONTRAST"): pure_colours.MIN_CONTRAST,
+    ("pure_colours.glsl", "MIN_REACH"): pure_colours.MIN_REACH,
     ("blend_model.glsl", "TINY"): float(blend_model._TINY),
     ("blend_model.glsl", "FAINT"): float(blend_model._FAINT),
 }

@@ -82,3 +82,43 @@ def test_engine_compute_takes_the_mode(shapes):
                                                             mode="paper"))
     with pytest.raises(aarecovery.InputError, match="'fast'"):
         engine.compute(mode="fast")
+
+
+def test_grain_tells_rendered_content_from_photographs():
+    from aarecovery.plan.texture import GRAIN_SHARE, grain
+    drawing = make_case(_scenes.render("shapes", 96, 4), "gamma", 4, "linear").original
+    assert grain(drawing) == 0.0
+    photo = make_case(_scenes.render("astronaut", 96, 4), "gamma", 4, "linear").original
+    grey = np.repeat(photo.mean(axis=-1, keepdims=True), 3, axis=-1)
+    assert grain(photo) > GRAIN_SHARE and grain(grey) > GRAIN_SHARE
+
+
+def test_a_grey_photograph_under_an_exposure_boost_is_not_destroyed():
+    """Grey photos have no colour lines to fail, so the colour test called them hard-edged
+    and the pure colours of thin features turned them into blotches (11-16 dB worse than F)."""
+    from aarecovery.lab.metrics import edge_band, psnr
+    scene = _scenes.render("astronaut", 96, 4)
+    scene = np.repeat(scene.mean(axis=-1, keepdims=True), 3, axis=-1)
+    case = make_case(scene, "gamma", 4, "linear", gamma=4.0)
+    plan = analyse(rgba(case.original), rgba(case.filtered))
+    assert plan.pure_colours is None, plan.reason
+    recovered = aarecovery.recover(case.original, case.filtered, backend="numpy")
+    band = edge_band(case.original, case.filtered, case.reference)
+    assert psnr(recovered, case.reference, band) >= psnr(case.filtered, case.reference, band) - 0.1
+
+
+def test_an_affine_filter_in_the_blend_space_keeps_f():
+    """A channel mixer in linear light commutes with antialiasing in linear light: F is the
+    reference already, and the safe default leaves it alone."""
+    from aarecovery.colour import linear_to_srgb, srgb_to_linear
+    from aarecovery.plan.linearity import affine_share
+    from aarecovery.spec.sobel import gradient_magnitude
+    original = make_case(_scenes.render("shapes", 64, 4), "gamma", 4, "linear").original
+    mixed = srgb_to_linear(original) @ np.array([[0.5, 0.2, 0.1], [0.3, 0.6, 0.2], [0.2, 0.2, 0.7]], np.float32)
+    filtered = linear_to_srgb(np.clip(mixed, 0, 1))
+    edges = gradient_magnitude(original) >= 0.02
+    assert affine_share(original, filtered, edges, "linear") == 1.0
+    assert affine_share(original, (original > 0.5).astype(np.float32), edges, "linear") < 0.5
+    plan = analyse(rgba(original), rgba(filtered))
+    assert plan.strength == 0 and "affine" in plan.reason
+    np.testing.assert_array_equal(aarecovery.recover(original, filtered, backend="numpy"), filtered)

@@ -28,9 +28,11 @@ from ..params import ITERATIONS, SIGMA_D, SIGMA_E
 from ..spec.sobel import gradient_magnitude
 from .blend_space import choose_blend_space
 from .calibration import EDGE_GRADIENT, calibrate_strength
+from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import pure_colour_prior
+from .texture import is_textured
 
 __all__ = ["PairAnalysis", "analyse", "analyse_pair", "analysis_crop"]
 
@@ -38,9 +40,6 @@ __all__ = ["PairAnalysis", "analyse", "analyse_pair", "analysis_crop"]
 # below is a global average that a 512 x 512 window estimates well, and it bounds the cost
 # of self-calibration to a few tenths of a second.
 _ANALYSIS_SIDE = 512
-# Texture: mean normalised colour-line residual of O's edge pixels above which the image is
-# treated as a photo. Synthetic scenes measured 0.000-0.005, photos 0.03-0.05.
-_TEXTURE_RESIDUAL = 0.015
 # Strength for neighbourhood (not point-wise, not low-pass) filters on photos: the paper's
 # method lost up to 3.4 dB there (unsharp mask, colour replacement) and gained at most 1 dB
 # (bilateral); no strength was safe for all, so F is kept.
@@ -117,8 +116,12 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     if lowpass:
         return PairAnalysis(space, 0.0, f"F is a low-pass (blur) of O (kernel residual {kernel_residual:.3f}): kept F")
     edges = gradient_magnitude(o) >= EDGE_GRADIENT
+    affine = affine_share(o, f, edges, space)
+    if affine >= AFFINE_SHARE:
+        return PairAnalysis(space, 0.0, f"F is an affine map of O in {space} values on {affine:.3f} of the edges, "
+                                        "so its edges are already right: kept F")
     transfer = fit_pointwise(o, f, edges)
-    textured = fit is not None and fit > _TEXTURE_RESIDUAL
+    textured, texture = is_textured(o, fit)
     if transfer.consistency >= POINTWISE_SHARE and not textured:
         # Hard-edged content: calibration would be biased here, since O is not a sharp
         # scene at twice the resolution (its edges are already blends) and box2(F) keeps
@@ -127,7 +130,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # With a monotone per-channel or luma table, thin features get their pure colours:
         # quick suite 0.600 -> 0.712 (linear), 0.628 -> 0.686 (sRGB); the table's ends
         # extended by a power law: 0.774 / 0.734.
-        prior = pure_colour_prior(o, transfer)
+        prior = pure_colour_prior(o, transfer, space)
         return PairAnalysis(space, 1.0, f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges "
                                         "match) on hard-edged content: full strength"
                                         + (", pure colours of thin features" if prior is not None else ""), prior)
@@ -138,6 +141,6 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                             f"half-resolution calibration chose strength {strength:g}")
     if textured:
         return PairAnalysis(space, _PHOTO_NEIGHBOURHOOD_STRENGTH,
-                            f"neighbourhood filter on a textured image (colour-line residual {fit:.3f}): "
+                            f"neighbourhood filter on a textured image ({texture}): "
                             f"strength {_PHOTO_NEIGHBOURHOOD_STRENGTH:g}")
     return PairAnalysis(space, 1.0, "neighbourhood filter on hard-edged content: full strength")

@@ -10,7 +10,7 @@ restore thin features' pure colours (``plan.pure_colours``) or calibrate the str
 import numpy as np
 
 from ..colour import LUMA, luma, srgb_to_linear
-from ..spec.pure_colours import SCALE_KEYS, key_values, scale_transfer
+from ..spec.pure_colours import LUMINANCE_KEYS, SCALE_KEYS, key_values, scale_transfer
 
 __all__ = ["PointwiseTransfer", "fit_pointwise", "filled_bins", "POINTWISE_SHARE"]
 
@@ -21,8 +21,23 @@ _LUT_TOLERANCE = 3.0 / 255
 POINTWISE_SHARE = 0.97
 
 
-def _keys(colour):
-    return {"channel": colour, "luma": luma(colour), "mean": colour.mean(axis=-1), "max": colour.max(axis=-1)}
+#: The keys a table can be indexed by, besides the scale keys: each channel, luma, mean, max
+#: (HSV value) and the encoded luminance of linear light (Rec. 709 and babl's D50 weights).
+TABLE_KEYS = ("channel", "luma", "mean", "max") + tuple(LUMINANCE_KEYS)
+
+
+def _key(colour, key):
+    """The values of `key` for encoded colour ``(..., 3)``: shape (..., 3) for "channel", else (...)."""
+    if key == "channel":
+        return colour
+    if key == "luma":
+        return luma(colour)
+    if key == "mean":
+        return colour.mean(axis=-1)
+    if key == "max":
+        return colour.max(axis=-1)
+    planes = np.ascontiguousarray(colour.reshape(-1, 3).T, dtype=np.float32)
+    return key_values(planes, key)[0].reshape(colour.shape[:-1])
 
 
 def _bins(key):
@@ -34,8 +49,9 @@ class PointwiseTransfer:
 
     Attributes
     ----------
-    key : {"channel", "luma", "mean", "max"}
-        What the table is indexed by: each channel of O on its own, or one value per pixel.
+    key : str
+        What the table is indexed by (:data:`TABLE_KEYS` or a scale key): each channel of O on
+        its own, or one value per pixel.
     table : ndarray of float32, shape (256, 3)
         Output colour per bin (for ``"channel"``, column c maps channel c).
     consistency : float
@@ -50,7 +66,7 @@ class PointwiseTransfer:
         if self.key in SCALE_KEYS:
             planes = np.ascontiguousarray(colour.reshape(-1, 3).T, dtype=np.float32)
             return scale_transfer(planes, self.key, self.table).T.reshape(colour.shape)
-        values = _keys(colour)[self.key]
+        values = _key(colour, self.key)
         index = _bins(values)
         if self.key == "channel":
             return np.stack([self.table[index[..., c], c] for c in range(3)], axis=-1)
@@ -81,9 +97,13 @@ def fit_pointwise(original, filtered, edges):
     scored_o, scored_f = original[scored], filtered[scored]
 
     def consistency(transfer):
-        return float((np.abs(transfer(scored_o) - scored_f).max(axis=-1) <= _LUT_TOLERANCE).mean())
+        miss = np.abs(transfer(scored_o) - scored_f).max(axis=-1)
+        # Ties (two colours fit any key) go to the key that reproduces F more closely.
+        transfer.mean_miss = float(miss.mean())
+        return float((miss <= _LUT_TOLERANCE).mean())
 
-    for key, values in _keys(original).items():
+    for key in TABLE_KEYS:
+        values = _key(original, key)
         index = _bins(values)
         table = np.empty((_LUT_BINS, 3), np.float32)
         for c in range(3):
@@ -96,20 +116,25 @@ def fit_pointwise(original, filtered, edges):
         transfer = PointwiseTransfer(key, table, 0.0)
         transfer.consistency = consistency(transfer)
         fitted.append(transfer)
-        if best is None or transfer.consistency > best.consistency:
+        if best is None or _better(transfer, best):
             best = transfer
     for key in SCALE_KEYS:
         chosen = None
         for table in _scale_tables(original, filtered, key):
             transfer = PointwiseTransfer(key, table, 0.0)
             transfer.consistency = consistency(transfer)
-            if chosen is None or transfer.consistency > chosen.consistency:
+            if chosen is None or _better(transfer, chosen):
                 chosen = transfer
         fitted.append(chosen)
-        if chosen.consistency > best.consistency:
+        if _better(chosen, best):
             best = chosen
-    best.alternatives = sorted(fitted, key=lambda t: -t.consistency)
+    best.alternatives = sorted(fitted, key=lambda t: (-t.consistency, t.mean_miss))
     return best
+
+
+def _better(transfer, other):
+    """More edge pixels matched, or as many matched more closely."""
+    return (transfer.consistency, -transfer.mean_miss) > (other.consistency, -other.mean_miss)
 
 
 def _scale_tables(original, filtered, key):

@@ -6,9 +6,14 @@ module builds what they need from the pair: a fitted table that is monotone, ext
 O's key range, and the palette of O's flat colours.
 """
 
+import dataclasses
+
 import numpy as np
 
-from ..spec.pure_colours import EXTENSION_KEYS, PALETTE_SIZE, PureColourPrior
+from ..params import SIGMA_D, SIGMA_E
+from ..spec import to_working_space
+from ..spec.pure_colours import (EXTENSION_KEYS, PALETTE_SIZE, PureColourPrior, filtered_colour,
+                                 fit_pure_colour_model)
 from .pointwise import POINTWISE_SHARE, filled_bins
 
 __all__ = ["palette_of", "is_monotone", "extrapolate_table", "pure_colour_prior"]
@@ -128,12 +133,12 @@ def extrapolate_table(table, filled):
     return out.astype(np.float32), low, high
 
 
-def pure_colour_prior(original, transfer):
+def pure_colour_prior(original, transfer, blend_space):
     """The prior for the passes, from the first fitted table fit for the extension.
 
     Keys often tie (a threshold of black/white text matches per channel and by luma); the
-    first candidate that matches F, is keyed per channel, by luma or by a scale key, and is
-    monotone is used.
+    best candidate that matches F, is keyed for the extension and is monotone is used, and
+    it extends to the cube only where the candidates that tie with it agree there.
 
     Parameters
     ----------
@@ -141,15 +146,57 @@ def pure_colour_prior(original, transfer):
         O's encoded colour (the analysis crop).
     transfer : PointwiseTransfer
         From ``fit_pointwise``, with its ``alternatives``.
+    blend_space : {"linear", "srgb"}
 
     Returns
     -------
     PureColourPrior or None
         None when no candidate qualifies.
     """
-    for candidate in transfer.alternatives:
-        if candidate.consistency >= POINTWISE_SHARE and candidate.key in EXTENSION_KEYS \
-                and is_monotone(candidate.table):
-            table, low, high = extrapolate_table(candidate.table, filled_bins(original, candidate.key))
-            return PureColourPrior(candidate.key, table, palette_of(original), low, high)
-    return None
+    palette = palette_of(original)
+    fit = [candidate for candidate in transfer.alternatives
+           if candidate.consistency >= POINTWISE_SHARE and candidate.key in EXTENSION_KEYS
+           and is_monotone(candidate.table)]
+    if not fit:
+        return None
+    priors = [PureColourPrior(candidate.key, palette=palette, **_extrapolated(original, candidate)) for candidate in fit
+              if candidate.consistency >= fit[0].consistency and candidate.mean_miss <= fit[0].mean_miss + _TIE_MISS]
+    chosen = priors[0]
+    if not _agree_where_extended(priors, original, blend_space):
+        chosen = dataclasses.replace(chosen, to_cube=False)
+    return chosen
+
+
+def _extrapolated(original, candidate):
+    table, low, high = extrapolate_table(candidate.table, filled_bins(original, candidate.key))
+    return {"table": table, "key_low": low, "key_high": high}
+
+
+# Tables that explain F within this mean miss of the best one tie with it.
+_TIE_MISS = 0.5 / 255
+# Tied tables agree where the extension lands when f of those colours differs by less than
+# this on this share of them.
+_AGREEMENT = 0.05
+_AGREEING_SHARE = 0.95
+
+
+def _agree_where_extended(priors, original, blend_space):
+    """Whether tied tables predict the same f on the pure colours the extension reaches.
+
+    On images of two or three colours every key explains F (the starburst: luma, mean and
+    both luminances matched every edge pixel of G'MIC's -luminance exactly) and the keys
+    disagree on colours O does not show: extending to the cube with the first of them lost
+    8 dB there. Black and white text ties too (per channel, luma, luminance), but its
+    extensions stay on the grey axis, where the keys agree.
+    """
+    if len(priors) < 2:
+        return True
+    opaque = np.ones(original.shape[:2] + (1,), np.float32)
+    work = to_working_space(np.concatenate([original, opaque], -1), blend_space=blend_space)
+    model = fit_pure_colour_model(work, work, SIGMA_D.default, SIGMA_E.default, 1.0, priors[0], blend_space)
+    colours = np.concatenate([model.colour_a[model.pure_a], model.colour_b[model.pure_b]]).T
+    if colours.shape[1] == 0:
+        return True
+    outputs = [filtered_colour(colours, prior, blend_space)[:3] for prior in priors]
+    agreeing = np.all([np.abs(output - outputs[0]).max(axis=0) < _AGREEMENT for output in outputs[1:]], axis=0)
+    return bool(agreeing.mean() >= _AGREEING_SHARE)

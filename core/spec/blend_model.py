@@ -56,6 +56,9 @@ class BlendModel:
         instead of R at the extreme pixel. None without a prior.
     fixed_a, fixed_b : ndarray of float32, shape (H, W, 4), or None
         The filtered pure colours (working space), meaningful where `pure_a` / `pure_b`.
+    colour_a, colour_b : ndarray of float32, shape (H, W, 4), or None
+        The pure colours themselves (working space), where `pure_a` / `pure_b`: what the safe
+        plan checks its choice of table on.
     """
 
     alpha: np.ndarray
@@ -68,6 +71,8 @@ class BlendModel:
     pure_b: np.ndarray = None
     fixed_a: np.ndarray = None
     fixed_b: np.ndarray = None
+    colour_a: np.ndarray = None
+    colour_b: np.ndarray = None
 
     #: The fields that every model has (the pure-colour ones exist only with a prior).
     MAP_FIELDS = ("alpha", "beta", "index_a", "index_b", "residual", "edge")

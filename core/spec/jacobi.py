@@ -48,3 +48,4 @@ def jacobi_step(recovered, filtered, model):
     alpha = model.alpha[..., None]
     beta = model.beta[..., None]
     return (beta * (alpha * at_a + (1 - alpha) * at_b) + (1 - beta) * filtered).astype(np.float32)
+

@@ -2,6 +2,7 @@
 // backend's only colour maths. The NumPy twin is aarecovery/colour.py.
 
 const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);  // Rec. 709 (aarecovery.colour.LUMA)
+const vec3 LUMINANCE_D50 = vec3(0.2225045, 0.7168786, 0.0606169);  // babl's Y (aarecovery.colour)
 
 vec3 srgb_to_linear(vec3 encoded) {
     vec3 low = encoded * (1.0 / 12.92);

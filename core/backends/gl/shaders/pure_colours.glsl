@@ -4,6 +4,7 @@
 
 uniform sampler2D transfer_table;  // 256 x 1: the filter's table, encoded output per key bin
 uniform int table_key;             // 0: each channel indexes its own column, 1: luma indexes all,
+                                   // 4/5: encoded luminance (Rec. 709 / D50 weights) indexes all,
                                    // 2/3: luma (encoded) / luminance (linear) mapped by column 0,
                                    // colour scaled with it (scale_transfer)
 uniform vec3 palette[32];          // O's flat colours, opaque, in the working space
@@ -11,6 +12,7 @@ uniform int palette_size;
 uniform vec3 key_low;              // O's key range (bin centres of the table's first and last
 uniform vec3 key_high;             // filled bins, per column); beyond it the table is extrapolated
 uniform int clamp_ends;            // 1: an extreme at an end of the range reads the table clamped
+uniform int to_cube;               // 0: extend only to a flat colour of O beyond the extreme
 
 const float PALETTE_TOLERANCE = 0.03;
 const float LINE_TOLERANCE = 0.05;
@@ -19,6 +21,7 @@ const float EXPLAIN_TOLERANCE = 0.02;
 const float RANGE_TOLERANCE = 0.05;
 const float END_TOLERANCE = 1.0 / 255.0;
 const float MIN_CONTRAST = 8.5 / 255.0;
+const float MIN_REACH = 1.2;
 
 float table_at(float key, int channel) {
     // Linear interpolation between bin centres, two fetches (no texture filtering: llvmpipe's
@@ -44,6 +47,12 @@ vec3 encoded_of(vec4 colour) {
 // The table keys of an encoded colour, one per table column (key_values).
 vec3 key_values(vec3 encoded) {
     if (table_key == 0) return encoded;
+    if (table_key == 4 || table_key == 5) {
+        // The encoded value of the luminance of linear light (LUMINANCE_KEYS).
+        vec3 weights = table_key == 4 ? LUMA : LUMINANCE_D50;
+        vec3 lin = srgb_to_linear(encoded);
+        return linear_to_srgb(vec3(lin.r * weights.r + lin.g * weights.g + lin.b * weights.b));
+    }
     vec3 values = table_key == 3 ? srgb_to_linear(encoded) : encoded;
     return vec3(values.r * LUMA.r + values.g * LUMA.g + values.b * LUMA.b);
 }
@@ -57,7 +66,7 @@ vec4 filtered_colour_clamped(vec4 colour, bvec3 low_end, bvec3 high_end) {
     keys = mix(keys, max(keys, key_low), vec3(low_end));
     keys = mix(keys, min(keys, key_high), vec3(high_end));
     vec3 out_colour;
-    if (table_key >= 2) {
+    if (table_key == 2 || table_key == 3) {
         vec3 values = table_key == 3 ? srgb_to_linear(encoded) : encoded;
         float luma = values.r * LUMA.r + values.g * LUMA.g + values.b * LUMA.b;
         float mapped = table_at(keys.r, 0);
@@ -153,6 +162,18 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
         reach = min(reach, min(up, down));
     }
     reach = max(reach, 1.0);
+    // A flat colour of O beyond the extreme, on its line, is the feature's ink.
+    float nearest = 1e6;
+    for (int i = 0; i < palette_size; ++i) {
+        vec4 offset = vec4(palette[i], 1.0) - near;
+        float along = dot(offset, direction);
+        float off_line = dot(offset, offset) - along * along;
+        if (along > t_far * (1.0 + RIDGE_MARGIN) && off_line < LINE_TOLERANCE * LINE_TOLERANCE)
+            nearest = min(nearest, along / len);
+    }
+    if (nearest < 1e5) reach = min(nearest, reach);
+    else if (to_cube == 0) return result;
+    if (!(reach > MIN_REACH)) return result;  // the extreme is the ink itself
     result.extended = true;
     result.colour = near + reach * span;
     // At an end of O's key range the extreme is read with the table clamped there (a dark
