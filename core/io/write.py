@@ -8,6 +8,7 @@ import numpy as np
 from ..contract import check_values, layout_of
 from ..errors import InputError
 from .formats import NPY_DTYPES, WRITE_FORMATS, import_codec, layout_name
+from .png import write_png
 
 __all__ = ["write_image", "check_output_path"]
 
@@ -87,8 +88,7 @@ def _encode(file, pixels, format_name):
     if format_name == "NPY":
         np.save(file, pixels, allow_pickle=False)
     elif format_name == "PNG":
-        imagecodecs = import_codec("imagecodecs", "PNG")
-        file.write(imagecodecs.png_encode(pixels))
+        write_png(file, pixels)
     elif format_name == "TIFF":
         tifffile = import_codec("tifffile", "TIFF")
         channels = 1 if pixels.ndim == 2 else pixels.shape[2]
