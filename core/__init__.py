@@ -19,8 +19,8 @@ from .backends.base import RecoveryMaps
 from .engine import Engine
 from .errors import InputError
 from .io import read_image, write_image
-from .params import BACKENDS, BLEND_SPACES, MODES, PARAMETERS
+from .params import BACKENDS, BLEND_SPACES, GL_PATHS, MODES, PARAMETERS
 from .pipeline import recover
 
 __all__ = ["recover", "Engine", "RecoveryMaps", "InputError", "read_image", "write_image", "filters",
-           "PARAMETERS", "BACKENDS", "MODES", "BLEND_SPACES", "__version__"]
+           "PARAMETERS", "BACKENDS", "GL_PATHS", "MODES", "BLEND_SPACES", "__version__"]

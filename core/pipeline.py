@@ -8,9 +8,10 @@ backend's passes) -> assemble the result in the filtered image's layout and dtyp
 import numpy as np
 
 from .backends.base import RecoveryMaps
-from .contract import check_same_size, check_values, layout_of
+from .contract import check_same_size, check_values, from_rgba_float, layout_of
 from .engine import Engine
-from .params import DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, Parameters, check_blend_space, check_mode
+from .params import (DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, Parameters, check_blend_space, check_gl_path,
+                     check_mode)
 from .plan import make_plan
 from .tiling import check_tile_size, halo_for, tiles
 
@@ -19,7 +20,7 @@ __all__ = ["recover"]
 
 def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
             backend="auto", linear=False, blend_space=None, return_maps=False, tile_size=None, engine=None,
-            mode=DEFAULT_MODE):
+            mode=DEFAULT_MODE, gl_path="auto"):
     """Repair the antialiased edges of `filtered` using the edges of `original`.
 
     Parameters
@@ -55,6 +56,9 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
         blend space, leaves blurred images alone, and calibrates the repair strength so that
         the result is not worse than `filtered` (see ``docs/quality.md``). ``"paper"`` is the
         method of Yang et al. (2011) exactly.
+    gl_path : {"auto", "fragment", "compute"}, optional
+        How the GL backend runs its passes (``aarecovery.params.GL_PATHS``); ``"auto"``
+        chooses by the GL version and a measured rule.
 
     Returns
     -------
@@ -81,6 +85,7 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     check_same_size(o_layout, f_layout)
     parameters = Parameters(sigma_d, sigma_e, iterations)
     check_mode(mode)
+    check_gl_path(gl_path)
     if blend_space is not None:
         check_blend_space(blend_space)
     if tile_size is not None:
@@ -94,7 +99,7 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
 
     own_engine = engine is None
     if own_engine:
-        engine = Engine(backend)
+        engine = Engine(backend, gl_path=gl_path)
     try:
         capabilities = engine.capabilities
         tile = min(capabilities.max_tile, tile_size or capabilities.default_tile)
@@ -103,16 +108,29 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
         maps = None
         if return_maps:
             maps = RecoveryMaps(*(np.empty((height, width), np.float32) for _ in RecoveryMaps.NAMES))
+        pending = None
         for inner, outer in tiles(height, width, tile, halo_for(plan.iterations)):
             engine.set_images(original[outer], filtered[outer], linear=linear, blend_space=plan.blend_space)
-            engine.run(plan, maps=return_maps)
+            engine.run(plan, maps=return_maps, wait=False)
             crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
-            result[inner] = engine.result()[crop]
             if return_maps:
                 tile_maps = engine.maps()
                 for name in RecoveryMaps.NAMES:
                     getattr(maps, name)[inner] = getattr(tile_maps, name)[crop]
+            # This tile's readback starts before the previous tile is folded into the result,
+            # so that on a GPU the copy overlaps the CPU's work.
+            started = engine.start_result(crop)
+            if pending is not None:
+                _fold(pending, result, f_layout)
+            pending = (started, inner)
+        if pending is not None:
+            _fold(pending, result, f_layout)
     finally:
         if own_engine:
             engine.release()
     return (result, maps) if return_maps else result
+
+
+def _fold(pending, result, layout):
+    started, inner = pending
+    from_rgba_float(started.wait(), layout, out=result[inner])

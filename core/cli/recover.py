@@ -6,7 +6,7 @@ import sys
 
 # Already imported with the package; the codecs and the engine's backends load in run().
 from ..errors import InputError
-from ..params import BACKENDS, BLEND_SPACES, PARAMETERS
+from ..params import BACKENDS, BLEND_SPACES, GL_PATHS, PARAMETERS
 from ..tiling import DEFAULT_TILES
 
 __all__ = ["register", "run", "MAP_SCALES"]
@@ -57,6 +57,9 @@ def register(subparsers):
     add_parameter_options(parser)
     parser.add_argument("--backend", choices=BACKENDS, default="auto",
                         help="auto uses OpenGL and falls back to NumPy (default %(default)s)")
+    parser.add_argument("--gl-path", choices=GL_PATHS, default="auto",
+                        help="how the GL backend runs its passes: fragment shaders (OpenGL 3.3) or compute "
+                             "shaders (OpenGL 4.3); auto picks the faster for the device (default %(default)s)")
     parser.add_argument("--linear", action="store_true",
                         help="the images hold linear-light values (default: sRGB-encoded)")
     parser.add_argument("--blend-space", choices=BLEND_SPACES, default=None,
@@ -73,8 +76,8 @@ def register(subparsers):
                              "is always replaced)")
     parser.add_argument("--tile-size", type=int, metavar="N",
                         help="largest tile side in pixels; larger images are processed in overlapping "
-                             f"tiles with the same result (default: {DEFAULT_TILES['gl']} on GL, "
-                             f"{DEFAULT_TILES['numpy']} on NumPy)")
+                             f"tiles with the same result (default: {DEFAULT_TILES['gl']} on a GPU, "
+                             f"{DEFAULT_TILES['gl-software']} on a CPU renderer, {DEFAULT_TILES['numpy']} on NumPy)")
     parser.set_defaults(run=run)
     return parser
 
@@ -118,25 +121,43 @@ def _write_maps(folder, maps):
         write_image(path, _visible_map(getattr(maps, name), MAP_SCALES[name]))
 
 
-def _make_engine(backend):
+def _make_engine(backend, gl_path):
+    """An engine, and the warnings its making raised (a fallback to NumPy), to print later."""
     import warnings
 
     from ..engine import Engine
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RuntimeWarning)
-        engine = Engine(backend)
+        engine = Engine(backend, gl_path=gl_path)
+    return engine, caught
+
+
+def _read_pair(paths, backend, gl_path):
+    """Decode both images in threads (the codecs release the GIL) while the engine's context is made."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ..io import read_image
+
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        reads = [pool.submit(read_image, path) for path in paths]
+        engine, caught = _make_engine(backend, gl_path)
+        try:
+            images = [read.result() for read in reads]
+        except BaseException:
+            engine.release()
+            raise
     for warning in caught:
         # The fallback notice already reads "aarecovery: ...": one line, not a traceback frame.
         print(f"{warning.message}", file=sys.stderr)
-    return engine
+    return engine, images
 
 
 def run(args):
     """Run ``aarecovery recover`` with parsed arguments; return the exit status."""
     import time
 
-    from ..io import check_output_path, read_image, write_image
+    from ..io import check_output_path, write_image
     from ..params import Parameters
     from ..pipeline import recover
     from ..tiling import check_tile_size
@@ -153,13 +174,10 @@ def run(args):
         outputs += _map_paths(args.maps).values()
     _refuse_overwriting_inputs(outputs, inputs, args.overwrite)
 
-    original = read_image(args.original)
-    filtered = read_image(args.filtered)
-    # Before the recovery, so that a long run does not end in a refusal.
-    check_output_path(args.output, filtered.shape)
-
-    engine = _make_engine(args.backend)
+    engine, (original, filtered) = _read_pair((args.original, args.filtered), args.backend, args.gl_path)
     try:
+        # Before the recovery, so that a long run does not end in a refusal.
+        check_output_path(args.output, filtered.shape)
         start = time.perf_counter()
         result = recover(original, filtered, sigma_d=params.sigma_d, sigma_e=params.sigma_e,
                          iterations=params.iterations, linear=args.linear, blend_space=args.blend_space,

@@ -1,0 +1,28 @@
+"""Reading the block lists a GL backend made on the GPU, for the tests."""
+
+import struct
+
+import numpy as np
+
+from aarecovery.backends.gl.blocks import DISPATCH_COMMAND_WORDS, DRAW_COMMAND_WORDS, LISTS
+
+
+def gpu_lists(impl, image_name):
+    """``{list name: (N, 2) int32 (column, row)}`` of the uploaded O or F (`image_name`), as
+    the GPU holds them; call with the backend's context current."""
+    lists = impl._block_lists(image_name)
+    words = struct.unpack(f"{len(LISTS) * (DRAW_COMMAND_WORDS + DISPATCH_COMMAND_WORDS)}I", lists.commands.read())
+    lengths = {name: words[DRAW_COMMAND_WORDS * index + 1] for index, name in enumerate(LISTS)}
+    if lists.counts is not None:
+        assert lists.counts == lengths
+    return {name: np.frombuffer(lists.buffers[name].read(), np.int32)[:2 * lengths[name]].reshape(-1, 2)
+            for name in LISTS}
+
+
+def dispatch_sizes(impl, image_name):
+    """``{list name: (x, y, z)}``: the indirect dispatch commands of the lists."""
+    lists = impl._block_lists(image_name)
+    words = struct.unpack(f"{len(LISTS) * (DRAW_COMMAND_WORDS + DISPATCH_COMMAND_WORDS)}I", lists.commands.read())
+    start = DRAW_COMMAND_WORDS * len(LISTS)
+    return {name: words[start + DISPATCH_COMMAND_WORDS * index:start + DISPATCH_COMMAND_WORDS * (index + 1)]
+            for index, name in enumerate(LISTS)}
