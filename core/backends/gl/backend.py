@@ -140,6 +140,9 @@ class GLBackend:
         #: Whether the compute path's fit keeps its neighbourhoods in shared memory: off, as
         #: no device measured faster with it (``paths.py``); ``aarecovery bench`` times both.
         self.shared_tile = False
+        #: None, or a callable that ``aarecovery bench`` gives to time the stages: called with
+        #: "upload", "classify" or "passes" once the work of that stage is finished.
+        self.stage_clock = None
         self._classifier = BlockClassifier(self.context, compute="compute" in self.capabilities.gl_paths)
         self._textures = {}
         self._pixel_buffers = {}
@@ -198,11 +201,18 @@ class GLBackend:
             else f_layout.channels
         self._upload("original", original, o_layout, o_dtype)
         self._upload("filtered", filtered, f_layout, f_dtype)
+        self._stage("upload")
         self._classified = set()
         self._working_lists = set()
         self._ran = None
         # F's blocks now, while its upload is fresh; O's are needed only with pure colours.
         self._block_lists("filtered")
+        self._stage("classify")
+
+    def _stage(self, name):
+        if self.stage_clock is not None:
+            self.context.finish()
+            self.stage_clock(name)
 
     def _upload(self, name, image, layout, dtype):
         pixels = image.reshape(layout.height, layout.width, layout.channels)
@@ -298,6 +308,7 @@ class GLBackend:
         # not: their passes cover O's active blocks, not F's.
         active = "filtered" if prior is None else "original"
         lists = self._block_lists(active)
+        self._stage("classify")
         original_work, filtered_work = self._working_textures()
         sources = {"original_work": original_work, "filtered_work": filtered_work,
                    "filtered_image": self._textures["filtered"]}
@@ -326,6 +337,7 @@ class GLBackend:
                                     defines=defines)
             if plan.iterations > 0:
                 self._jacobi_steps(sources, defines, lists, plan.iterations)
+        self._stage("passes")
         self._ran = {"maps": maps}
 
     def _transfer_table(self, prior):
