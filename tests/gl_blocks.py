@@ -4,19 +4,23 @@ import struct
 
 import numpy as np
 
-from aarecovery.backends.gl.blocks import DISPATCH_COMMAND_WORDS, DRAW_COMMAND_WORDS, LISTS
+from aarecovery.backends.gl.blocks import DISPATCH_COMMAND_WORDS, DRAW_COMMAND_WORDS, LISTS, expand_runs
 
 
-def gpu_lists(impl, image_name):
-    """``{list name: (N, 2) int32 (column, row)}`` of the uploaded O or F (`image_name`), as
-    the GPU holds them; call with the backend's context current."""
+def gpu_lists(impl, image_name, raw=False):
+    """``{list name: (N, 2) int32 (column, row)}`` of the uploaded O or F (`image_name`): the
+    blocks, or with `raw` the entries as the GPU holds them (runs on the fragment path);
+    call with the backend's context current."""
     lists = impl._block_lists(image_name)
     words = struct.unpack(f"{len(LISTS) * (DRAW_COMMAND_WORDS + DISPATCH_COMMAND_WORDS)}I", lists.commands.read())
     lengths = {name: words[DRAW_COMMAND_WORDS * index + 1] for index, name in enumerate(LISTS)}
     if lists.counts is not None:
         assert lists.counts == lengths
-    return {name: np.frombuffer(lists.buffers[name].read(), np.int32)[:2 * lengths[name]].reshape(-1, 2)
-            for name in LISTS}
+    entries = {name: np.frombuffer(lists.buffers[name].read(), np.int32)[:2 * lengths[name]].reshape(-1, 2)
+               for name in LISTS}
+    if raw or not impl._classifier.runs:
+        return entries
+    return {name: expand_runs(listed) for name, listed in entries.items()}
 
 
 def dispatch_sizes(impl, image_name):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import aarecovery
-from aarecovery.backends.gl.blocks import LISTS, active_blocks, active_mask, block_lists
+from aarecovery.backends.gl.blocks import LISTS, active_blocks, active_mask, block_lists, expand_runs
 from gl_blocks import dispatch_sizes, gpu_lists
 
 pytestmark = pytest.mark.gl
@@ -38,10 +38,11 @@ def _uploaded(image):
     return np.ascontiguousarray(image.reshape(image.shape[0], image.shape[1], -1), dtype=dtype)
 
 
-@pytest.fixture(scope="module", params=["compute", "fragment-mask"])
+@pytest.fixture(scope="module", params=["compute-runs", "compute-blocks", "fragment-mask-runs", "fragment-mask-blocks"])
 def classifying_engine(request):
     engine = aarecovery.Engine(backend="gl", gl_path="fragment")
-    engine._impl._classifier.compute = request.param == "compute"
+    engine._impl._classifier.compute = request.param.startswith("compute")
+    engine._impl._classifier.runs = request.param.endswith("runs")
     yield engine
     engine.release()
 
@@ -50,11 +51,12 @@ def classifying_engine(request):
 def test_gpu_lists_equal_numpy_lists(classifying_engine, name, image):
     flat = np.zeros_like(image)
     classifying_engine.set_images(image, flat)
+    impl = classifying_engine._impl
     with classifying_engine.context:
-        found = {which: gpu_lists(classifying_engine._impl, which) for which in ("original", "filtered")}
-        dispatches = dispatch_sizes(classifying_engine._impl, "original")
+        found = {which: gpu_lists(impl, which, raw=True) for which in ("original", "filtered")}
+        dispatches = dispatch_sizes(impl, "original")
     for which, pixels in (("original", image), ("filtered", flat)):
-        expected = block_lists(active_mask(_uploaded(pixels)))
+        expected = block_lists(active_mask(_uploaded(pixels)), runs=impl._classifier.runs)
         for list_name in LISTS:
             assert sorted(map(tuple, found[which][list_name])) == sorted(map(tuple, expected[list_name])), \
                 (which, list_name)
@@ -65,10 +67,12 @@ def test_gpu_lists_equal_numpy_lists(classifying_engine, name, image):
 
 def test_numpy_lists_are_consistent():
     # The dilated list holds every active block and its 8 neighbours; active and inactive split
-    # the grid.
+    # the grid; runs hold the same blocks.
     image = _uploaded(IMAGES[2][1])
     mask = active_mask(image)
     lists = block_lists(mask)
+    for name, runs in block_lists(mask, runs=True).items():
+        assert sorted(map(tuple, expand_runs(runs))) == sorted(map(tuple, lists[name]))
     assert sorted(map(tuple, lists["active"])) == sorted(map(tuple, active_blocks(image)))
     assert len(lists["active"]) + len(lists["inactive"]) == mask.size
     dilated = set(map(tuple, lists["dilated"]))

@@ -143,7 +143,8 @@ class GLBackend:
         #: None, or a callable that ``aarecovery bench`` gives to time the stages: called with
         #: "upload", "classify" or "passes" once the work of that stage is finished.
         self.stage_clock = None
-        self._classifier = BlockClassifier(self.context, compute="compute" in self.capabilities.gl_paths)
+        self._classifier = BlockClassifier(self.context, compute="compute" in self.capabilities.gl_paths,
+                                           runs=path == "fragment")
         self._textures = {}
         self._pixel_buffers = {}
         self._key = None

@@ -13,7 +13,7 @@ turns a block mask made on the GPU into lists.
 import numpy as np
 
 __all__ = ["BLOCK_SIDE", "MARGIN", "LISTS", "DRAW_COMMAND_WORDS", "DISPATCH_COMMAND_WORDS", "active_mask",
-           "active_blocks", "block_lists"]
+           "active_blocks", "block_lists", "expand_runs"]
 
 BLOCK_SIDE = 16
 #: Pixels around a block whose differences still wake it (see :func:`active_mask`).
@@ -92,18 +92,36 @@ def active_blocks(pixels, side=BLOCK_SIDE, margin=MARGIN):
     return _as_list(active_mask(pixels, side, margin))
 
 
-def block_lists(mask):
+def _as_runs(mask):
+    """Runs of true blocks along rows, ``(column | (length - 1) << 16, row)``, row-major."""
+    edges = np.diff(np.pad(mask, ((0, 0), (1, 1))).astype(np.int8), axis=1)
+    starts, stops = np.argwhere(edges == 1), np.argwhere(edges == -1)  # pairs, in the same order
+    runs = np.stack([starts[:, 1] | ((stops[:, 1] - starts[:, 1] - 1) << 16), starts[:, 0]], axis=-1)
+    return np.ascontiguousarray(runs, dtype=np.int32)
+
+
+def expand_runs(entries):
+    """The blocks of run entries (see :func:`block_lists`), as ``(column, row)`` pairs."""
+    blocks = [(column & 0xFFFF) + offset for column, _ in entries for offset in range((column >> 16) + 1)]
+    rows = [row for column, row in entries for _ in range((column >> 16) + 1)]
+    return np.asarray(list(zip(blocks, rows)), dtype=np.int32).reshape(-1, 2)
+
+
+def block_lists(mask, runs=False):
     """The three lists of :data:`LISTS` from a block mask.
 
     Parameters
     ----------
     mask : ndarray of bool, shape (rows, columns)
         Active blocks (:func:`active_mask`, or the GPU's block mask).
+    runs : bool
+        List runs of blocks along rows, as the fragment path draws them: one entry
+        ``(column | (length - 1) << 16, row)`` per run.
 
     Returns
     -------
     dict of str to ndarray of int32, shape (N, 2)
-        ``(column, row)`` block indices per list, row-major.
+        ``(column, row)`` block indices (or runs) per list, row-major.
     """
     padded = np.pad(mask, 1)
     rows, columns = mask.shape
@@ -111,4 +129,5 @@ def block_lists(mask):
     for dy in range(3):
         for dx in range(3):
             dilated |= padded[dy:dy + rows, dx:dx + columns]
-    return {"active": _as_list(mask), "dilated": _as_list(dilated), "inactive": _as_list(~mask)}
+    listed = _as_runs if runs else _as_list
+    return {"active": listed(mask), "dilated": listed(dilated), "inactive": listed(~mask)}

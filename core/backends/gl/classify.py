@@ -92,11 +92,15 @@ class BlockClassifier:
     context : moderngl.Context
     compute : bool
         Whether the context has compute shaders (GL 4.3).
+    runs : bool
+        List runs of blocks along rows (for drawing, the fragment path) instead of blocks
+        (for dispatching, the compute path).
     """
 
-    def __init__(self, context, compute):
+    def __init__(self, context, compute, runs):
         self.context = context
         self.compute = compute
+        self.runs = runs
         self._programs = {}
         self._flags = None
         self._mask_targets = {}
@@ -104,9 +108,10 @@ class BlockClassifier:
         self.max_groups = MAX_GROUPS
 
     def _compute_shader(self, name):
-        key = (name, self.max_groups)
+        key = (name, self.max_groups, self.runs)
         if key not in self._programs:
-            self._programs[key] = self.context.compute_shader(load_source(name, {"MAX_GROUPS": self.max_groups}))
+            self._programs[key] = self.context.compute_shader(
+                load_source(name, {"MAX_GROUPS": self.max_groups, "RUNS": int(self.runs)}))
         return self._programs[key]
 
     def classify(self, texture, lists):
@@ -166,7 +171,7 @@ class BlockClassifier:
         framebuffer.use()
         vertex_array.render(moderngl.TRIANGLES, vertices=3)
         flags = np.frombuffer(framebuffer.read(components=1), np.uint8).reshape(grid[1], grid[0])
-        listed = block_lists(flags != 0)
+        listed = block_lists(flags != 0, runs=self.runs)
         for name in LISTS:
             if len(listed[name]):
                 lists.buffers[name].write(listed[name].tobytes())
