@@ -160,6 +160,24 @@ class GLBackend:
     # -- images -----------------------------------------------------------------------------
     @_current
     def load(self, original, o_layout, filtered, f_layout, linear_input, blend_space):
+        o_dtype, f_dtype = self._configure(o_layout, f_layout, linear_input, blend_space)
+        size = (f_layout.width, f_layout.height)
+        key = (size, o_dtype, o_layout.channels, f_dtype, f_layout.channels)
+        if key != self._key:
+            self._allocate(size, o_dtype, o_layout.channels, f_dtype, f_layout.channels)
+            self._key = key
+        self._upload("original", original, o_layout, o_dtype)
+        self._upload("filtered", filtered, f_layout, f_dtype)
+        self._stage("upload")
+        self._classified = set()
+        self._working_lists = set()
+        self._ran = None
+        # F's blocks now, while its upload is fresh; O's are needed only with pure colours.
+        self._block_lists("filtered")
+        self._stage("classify")
+
+    def _configure(self, o_layout, f_layout, linear_input, blend_space):
+        """The shader defines and formats for a pair; returns the textures' dtypes for O and F."""
         if blend_space == "linear" and not linear_input:
             input_mode, output_mode = _CONVERT_DECODE, _CONVERT_ENCODE
         elif blend_space == "srgb" and linear_input:
@@ -167,18 +185,20 @@ class GLBackend:
         else:
             input_mode = output_mode = _CONVERT_NONE
         # The result texture has F's format where the path can write it (compute shaders store
-        # no 3-channel formats, and 16-bit RGB need not be renderable): every pass but the
-        # last then starts from a copy of F, and the readback needs no conversion.
+        # no 3-channel formats, and 16-bit RGB need not be renderable): it then starts as a
+        # copy of F, and the readback needs no conversion.
         bits = _RESULT_BITS.get(np.dtype(f_layout.dtype))
         self._result_is_filtered_format = bits is not None and (
             f_layout.channels != 3 or (bits == 8 and self._path.name == "fragment"))
+        result_channels = f_layout.channels if self._result_is_filtered_format else 4
         self._defines = {"INPUT_CONVERT": input_mode, "OUTPUT_CONVERT": output_mode,
                          "EXACT_UNTOUCHED": int(f_layout.dtype != np.uint8),
-                         "WORK_IS_LINEAR": int(blend_space == "linear"),
-                         "RESULT_CHANNELS": f_layout.channels if self._result_is_filtered_format else 4}
-        # The image format of the result texture, for the compute path's imageStore.
-        self._defines["RESULT_FORMAT"] = ("r", "rg", "rgb", "rgba")[self._defines["RESULT_CHANNELS"] - 1] + \
-            (str(bits) if bits else "32f")
+                         "WORK_IS_LINEAR": int(blend_space == "linear"), "RESULT_CHANNELS": result_channels,
+                         # The result texture's image format, for the compute path's imageStore.
+                         "RESULT_FORMAT": ("r", "rg", "rgb", "rgba")[result_channels - 1] + (str(bits) if bits else "32f")}
+        # Straight from the result texture into the caller's layout where it holds F's
+        # channels in order (grey+alpha in RGBA does not).
+        self._readback_channels = 4 if result_channels == 4 and f_layout.channels == 2 else f_layout.channels
         self._blend_space = blend_space
         self._linear = dict.fromkeys(("original", "filtered", "result"), linear_input)
 
@@ -191,24 +211,7 @@ class GLBackend:
         # Float inputs are not: the pass clamps them to [0, 1].
         self._uploads_are_working = (input_mode == _CONVERT_NONE and o_dtype != np.float32 and f_dtype != np.float32
                                      and not o_layout.alpha and not f_layout.alpha)
-        size = (f_layout.width, f_layout.height)
-        key = (size, o_dtype, o_layout.channels, f_dtype, f_layout.channels)
-        if key != self._key:
-            self._allocate(size, o_dtype, o_layout.channels, f_dtype, f_layout.channels)
-            self._key = key
-        # Straight from the result texture into the caller's layout where it holds F's
-        # channels in order (grey+alpha in RGBA does not).
-        self._readback_channels = 4 if self._defines["RESULT_CHANNELS"] == 4 and f_layout.channels == 2 \
-            else f_layout.channels
-        self._upload("original", original, o_layout, o_dtype)
-        self._upload("filtered", filtered, f_layout, f_dtype)
-        self._stage("upload")
-        self._classified = set()
-        self._working_lists = set()
-        self._ran = None
-        # F's blocks now, while its upload is fresh; O's are needed only with pure colours.
-        self._block_lists("filtered")
-        self._stage("classify")
+        return o_dtype, f_dtype
 
     def _stage(self, name):
         if self.stage_clock is not None:

@@ -2,8 +2,8 @@
 
 Both paths run the same passes, built from the same GLSL function libraries (``blend_model.glsl``,
 ``jacobi.glsl``, ``working.glsl``, ...): ``NAME.frag`` draws a full-screen triangle or a quad
-per listed block, ``NAME.comp`` runs a 16 x 16 work group per block and stores its outputs
-with ``imageStore``. A pass names its inputs (sampler uniforms, :data:`SAMPLER_UNITS`) and its
+per listed run of blocks, ``NAME.comp`` runs a 16 x 16 work group per listed block and stores
+its outputs with ``imageStore``. A pass names its inputs (sampler uniforms, :data:`SAMPLER_UNITS`) and its
 outputs in order (fragment output locations, image bindings).
 
 Which path ``"auto"`` runs (:func:`choose_path`), measured:
@@ -111,6 +111,9 @@ class FragmentPath(_Path):
     def __init__(self, context, framebuffer):
         super().__init__(context, framebuffer)
         self._block_arrays = {}
+        # A CPU renderer draws a list that covers nearly everything as one triangle
+        # (classify.FULL_SCREEN_SHARE); asking costs a GPU a wait, so it never asks.
+        self._full_screen_when_nearly_everything = software_renderer(context)
 
     def _program(self, shader, vertex, defines):
         key = (shader, vertex, tuple(sorted(defines.items())))
@@ -137,6 +140,8 @@ class FragmentPath(_Path):
             One of ``blocks.LISTS``, with `blocks`.
         uniforms, defines : dict, optional
         """
+        if blocks is not None and self._full_screen_when_nearly_everything and blocks.nearly_everything(list_name):
+            blocks = None
         program, full_screen = self._program(shader, "fullscreen.vert" if blocks is None else "blocks.vert",
                                              defines or {})
         self._prepare(program, inputs, uniforms or {})

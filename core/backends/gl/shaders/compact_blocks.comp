@@ -45,6 +45,11 @@ void append(int list, ivec2 block) {
     ivec2 entry = block;
 #endif
     uint index = atomicAdd(block_commands[DRAW_COMMAND_WORDS * list + 1], 1u);
+#if RUNS
+    atomicAdd(block_commands[BLOCK_COUNTS + list], uint(length));
+#else
+    atomicAdd(block_commands[BLOCK_COUNTS + list], 1u);
+#endif
     if (list == LIST_ACTIVE) active_list[index] = entry;
     else if (list == LIST_DILATED) dilated_list[index] = entry;
     else inactive_list[index] = entry;
