@@ -50,7 +50,7 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
         Largest tile side; images larger than this are processed in overlapping tiles whose
         result equals the untiled one. By default the backend's own limit.
     engine : Engine, optional
-        An engine to reuse (its backend wins over `backend`).
+        An engine to reuse (its backend and GL path win over `backend` and `gl_path`).
     mode : {"safe", "paper"}, optional
         ``"safe"`` (the default) analyses the whole pair once before tiling: it picks the
         blend space, leaves blurred images alone, and calibrates the repair strength so that

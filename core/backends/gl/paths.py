@@ -8,11 +8,11 @@ outputs in order (fragment output locations, image bindings).
 
 Which path ``"auto"`` runs (:func:`choose_path`), measured:
 
-* Mesa llvmpipe (2 cores, GL 4.5): the fragment path. CPU time of the passes of
-  ``mode="paper"`` on a 4096 x 4096 pair, fragment against compute: 0.72 s against 1.23 s
-  thresholded, 3.2 s against 8.2 s under gamma (every pixel fitted). llvmpipe shades
-  fragments in 2x2 quads on its rasterizer threads; a compute work group is a loop over its
-  invocations.
+* Mesa llvmpipe (2 cores, GL 4.5): the fragment path. CPU time of the classification and
+  passes of ``mode="paper"`` on a 2048 x 2048 pair, fragment against compute: 169 ms against
+  377 ms thresholded, 540 ms against 1413 ms under gamma (every pixel fitted). llvmpipe
+  shades fragments in 2x2 quads on its rasterizer threads; a compute work group is a loop
+  over its invocations.
 * NVIDIA H100 (GL 4.6, a prototype of the same per-pixel work at 3840 x 2160): the compute
   path, 9.9 GP/s with RGBA32F textures against 0.53 GP/s for fragment passes; data-centre
   GPUs give fragment shading only a few of their units.
