@@ -20,9 +20,10 @@ from .backends import GLUnavailable
 from .engine import Engine
 from .errors import InputError, OrderWarning
 from .io import read_image, write_image
-from .params import BACKENDS, BLEND_SPACES, MODES, PARAMETERS
+from .params import BACKENDS, BLEND_SPACES, GL_PATHS, MODES, PARAMETERS
 from .pipeline import recover
 from .plan.order import check_order
 
 __all__ = ["recover", "check_order", "Engine", "RecoveryMaps", "InputError", "GLUnavailable", "OrderWarning",
-           "read_image", "write_image", "filters", "PARAMETERS", "BACKENDS", "MODES", "BLEND_SPACES", "__version__"]
+           "read_image", "write_image", "filters", "PARAMETERS", "BACKENDS", "GL_PATHS", "MODES", "BLEND_SPACES",
+           "__version__"]

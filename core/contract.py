@@ -163,33 +163,46 @@ def to_rgba_float(image, layout, name, out=None):
     return out
 
 
-def from_rgba_float(rgba, layout):
+def from_rgba_float(rgba, layout, out=None):
     """Give a core image back in a caller's layout and dtype.
 
     Parameters
     ----------
-    rgba : ndarray, shape (H, W, 4)
+    rgba : ndarray, shape (H, W, 4) or (H, W, C)
         Straight RGBA: float32 in [0, 1], or already in ``layout.dtype`` (a GL readback of a
-        normalised texture), in which case only the channels are folded.
+        normalised texture), in which case only the channels are folded; or already in the
+        layout's C channels and dtype (a GL readback of a texture in F's own format).
     layout : Layout
         The layout to return (normally the filtered image's).
+    out : ndarray, optional
+        Where to write the result instead (a tile's part of the whole result): the shape
+        ``layout`` describes for `rgba`'s height and width, ``layout.dtype``.
 
     Returns
     -------
     ndarray
-        Shape ``layout.shape`` and dtype ``layout.dtype``. Grey results take the first colour
-        channel: recovery blends grey inputs into equal channels, so nothing is lost.
+        Shape ``layout.shape`` and dtype ``layout.dtype`` (or `out`). Grey results take the
+        first colour channel: recovery blends grey inputs into equal channels, so nothing is
+        lost.
     """
-    if layout.grey:
+    if rgba.shape[-1] == layout.channels:
+        picked = rgba
+    elif layout.grey:
         picked = rgba[..., [0, 3]] if layout.alpha else rgba[..., 0]
     else:
-        picked = rgba if layout.alpha else rgba[..., :3]
-    result = picked.reshape(layout.shape)
-    if result.dtype == layout.dtype:
+        picked = rgba[..., :3]
+    result = picked.reshape(layout.shape if out is None else out.shape)
+    if result.dtype != layout.dtype:
+        if layout.dtype == np.uint8:
+            result = np.rint(np.clip(result, 0, 1) * 255).astype(np.uint8)
+        elif layout.dtype == np.uint16:
+            result = np.rint(np.clip(result, 0, 1) * 65535).astype(np.uint16)
+        else:
+            result = np.clip(result, 0, 1).astype(layout.dtype)
+    elif out is None:
         # Always a copy: a backend may hand over its reusable readback buffer.
         return np.array(result, order="C", copy=True)
-    if layout.dtype == np.uint8:
-        return np.rint(np.clip(result, 0, 1) * 255).astype(np.uint8)
-    if layout.dtype == np.uint16:
-        return np.rint(np.clip(result, 0, 1) * 65535).astype(np.uint16)
-    return np.clip(result, 0, 1).astype(layout.dtype)
+    if out is None:
+        return result
+    out[...] = result
+    return out

@@ -27,6 +27,9 @@ class Engine:
     context : moderngl.Context, optional
         A context to borrow (a viewer's window); by default the engine makes a standalone
         EGL (or platform default) context and owns it.
+    gl_path : {"auto", "fragment", "compute"}
+        How the GL backend runs its passes: ``"auto"`` chooses by the context's capabilities
+        and a measured rule; ``"compute"`` needs OpenGL 4.3. Only ``"auto"`` with NumPy.
 
     Examples
     --------
@@ -36,8 +39,8 @@ class Engine:
     ...     result = engine.recover(sigma_e=sigma_e)
     """
 
-    def __init__(self, backend="auto", *, context=None):
-        self._impl = make_backend(backend, context)
+    def __init__(self, backend="auto", *, context=None, gl_path="auto"):
+        self._impl = make_backend(backend, context, gl_path)
         self._released = False
         # None, or {"maps": bool} once a run finished on the loaded pair.
         self._computed = None
@@ -57,8 +60,13 @@ class Engine:
 
     @property
     def capabilities(self):
-        """Capabilities: the backend's largest and preferred tile sides."""
+        """Capabilities: the backend's largest and preferred tile sides and its GL paths."""
         return self._impl.capabilities
+
+    @property
+    def gl_path(self):
+        """str or None: ``"fragment"`` or ``"compute"``, how the GL backend runs its passes."""
+        return self._impl.capabilities.gl_path
 
     @property
     def context(self):
@@ -163,11 +171,13 @@ class Engine:
         """
         self.run(self.plan(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode), maps=maps)
 
-    def run(self, plan, *, maps=False):
+    def run(self, plan, *, maps=False, wait=True):
         """Run a resolved :class:`Plan` on the loaded pair; the result stays in the backend.
 
         The plan may come from :meth:`plan` or, when one pair is recovered in tiles, from
-        ``aarecovery.plan.make_plan`` on the whole pair.
+        ``aarecovery.plan.make_plan`` on the whole pair. With ``wait=False`` the GL backend
+        returns as soon as the passes are queued (and :attr:`last_seconds` is None), so
+        that a tiled caller can read the previous tile back meanwhile (:meth:`start_result`).
         """
         self._require_images()
         if plan.blend_space != self._loaded_space:
@@ -175,9 +185,11 @@ class Engine:
         start = time.perf_counter()
         self._computed = None
         self._impl.run(plan, maps)
-        self._impl.finish()
+        self.last_seconds = None
+        if wait:
+            self._impl.finish()
+            self.last_seconds = time.perf_counter() - start
         self._computed = {"maps": bool(maps)}
-        self.last_seconds = time.perf_counter() - start
         self.last_plan = plan
 
     def result(self):
@@ -194,7 +206,25 @@ class Engine:
             Before :meth:`set_images` and :meth:`compute`, and after :meth:`release`.
         """
         self._require_computed()
-        return from_rgba_float(self._impl.read_result(), self._layout)
+        return from_rgba_float(self._impl.start_readback().wait(), self._layout)
+
+    def start_result(self, window=None):
+        """Start reading the last result back, for a caller that overlaps tiles.
+
+        Parameters
+        ----------
+        window : (slice, slice), optional
+            The rows and columns to read (a tile's own part); all by default.
+
+        Returns
+        -------
+        object
+            Its ``wait()`` returns the result as the backend holds it (see
+            ``Backend.start_readback``), to be folded into F's layout with
+            ``aarecovery.contract.from_rgba_float``; valid until two more results are started.
+        """
+        self._require_computed()
+        return self._impl.start_readback(window)
 
     def recover(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
                 mode=DEFAULT_MODE):

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 from .errors import InputError
 
 __all__ = ["ParameterSpec", "PARAMETERS", "SIGMA_D", "SIGMA_E", "ITERATIONS", "Parameters", "MODES",
-           "DEFAULT_MODE", "BLEND_SPACES", "BACKENDS", "check_mode", "check_blend_space", "check_backend"]
+           "DEFAULT_MODE", "BLEND_SPACES", "BACKENDS", "GL_PATHS", "check_mode", "check_blend_space", "check_backend",
+           "check_gl_path"]
 
 
 @dataclass(frozen=True)
@@ -90,6 +91,10 @@ DEFAULT_MODE = MODES[0]
 BLEND_SPACES = ("linear", "srgb")
 #: ``"auto"`` uses OpenGL and falls back to NumPy with a warning.
 BACKENDS = ("auto", "gl", "numpy")
+#: How the GL backend runs its passes: ``"auto"`` chooses by the context's capabilities and
+#: a measured rule (``aarecovery.backends.gl.paths``), ``"fragment"`` draws (OpenGL 3.3),
+#: ``"compute"`` dispatches compute shaders (OpenGL 4.3).
+GL_PATHS = ("auto", "fragment", "compute")
 
 
 @dataclass(frozen=True)
@@ -131,3 +136,8 @@ def check_mode(mode):
 def check_backend(backend):
     """Raise unless `backend` is one of :data:`BACKENDS`."""
     return _check_choice(backend, "backend", BACKENDS)
+
+
+def check_gl_path(gl_path):
+    """Raise unless `gl_path` is one of :data:`GL_PATHS`."""
+    return _check_choice(gl_path, "gl_path", GL_PATHS)

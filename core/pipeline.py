@@ -10,11 +10,12 @@ import warnings
 import numpy as np
 
 from .backends.base import RecoveryMaps
-from .contract import check_same_size, check_values, layout_of
+from .contract import check_same_size, check_values, from_rgba_float, layout_of
 from .engine import Engine
 from .errors import NotEnoughMemory, OrderWarning
 from .memory import not_enough_memory
-from .params import DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, Parameters, check_blend_space, check_mode
+from .params import (DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, Parameters, check_blend_space, check_gl_path,
+                     check_mode)
 from .plan import make_plan
 from .plan.order import check_order
 from .tiling import DEFAULT_TILES, check_tile_size, halo_for, tiles
@@ -24,7 +25,7 @@ __all__ = ["recover"]
 
 def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
             backend="auto", linear=False, blend_space=None, return_maps=False, tile_size=None, engine=None,
-            mode=DEFAULT_MODE):
+            mode=DEFAULT_MODE, gl_path="auto"):
     """Repair the antialiased edges of `filtered` using the edges of `original`.
 
     Parameters
@@ -54,12 +55,15 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
         Largest tile side; images larger than this are processed in overlapping tiles whose
         result equals the untiled one. By default the backend's own limit.
     engine : Engine, optional
-        An engine to reuse (its backend wins over `backend`).
+        An engine to reuse (its backend and GL path win over `backend` and `gl_path`).
     mode : {"safe", "paper"}, optional
         ``"safe"`` (the default) analyses the whole pair once before tiling: it picks the
         blend space, leaves blurred images alone, and calibrates the repair strength so that
         the result is not worse than `filtered` (see ``docs/quality.md``). ``"paper"`` is the
         method of Yang et al. (2011) exactly.
+    gl_path : {"auto", "fragment", "compute"}, optional
+        How the GL backend runs its passes (``aarecovery.params.GL_PATHS``); ``"auto"``
+        chooses by the GL version and a measured rule.
 
     Returns
     -------
@@ -93,6 +97,7 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     check_same_size(o_layout, f_layout)
     parameters = Parameters(sigma_d, sigma_e, iterations)
     check_mode(mode)
+    check_gl_path(gl_path)
     if blend_space is not None:
         check_blend_space(blend_space)
     if tile_size is not None:
@@ -113,7 +118,7 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
 
     own_engine = engine is None
     if own_engine:
-        engine = Engine(backend)
+        engine = Engine(backend, gl_path=gl_path)
     tile = min(engine.capabilities.max_tile, tile_size or engine.capabilities.default_tile)
     try:
         return _recover_in_tiles(original, filtered, f_layout, plan, engine, tile, linear, return_maps)
@@ -137,13 +142,26 @@ def _recover_in_tiles(original, filtered, f_layout, plan, engine, tile, linear, 
     maps = None
     if return_maps:
         maps = RecoveryMaps(*(np.empty((height, width), np.float32) for _ in RecoveryMaps.NAMES))
+    pending = None
     for inner, outer in tiles(height, width, tile, halo_for(plan.iterations)):
         engine.set_images(original[outer], filtered[outer], linear=linear, blend_space=plan.blend_space)
-        engine.run(plan, maps=return_maps)
+        engine.run(plan, maps=return_maps, wait=False)
         crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
-        result[inner] = engine.result()[crop]
         if return_maps:
             tile_maps = engine.maps()
             for name in RecoveryMaps.NAMES:
                 getattr(maps, name)[inner] = getattr(tile_maps, name)[crop]
+        # This tile's readback starts before the previous tile is folded into the result,
+        # so that on a GPU the copy overlaps the CPU's work.
+        started = engine.start_result(crop)
+        if pending is not None:
+            _fold(pending, result, f_layout)
+        pending = (started, inner)
+    if pending is not None:
+        _fold(pending, result, f_layout)
     return (result, maps) if return_maps else result
+
+
+def _fold(pending, result, layout):
+    started, inner = pending
+    from_rgba_float(started.wait(), layout, out=result[inner])

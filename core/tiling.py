@@ -16,11 +16,12 @@ __all__ = ["DEFAULT_TILES", "SENSIBLE_TILE", "halo_for", "tiles", "smallest_tile
 
 #: The tile side each backend runs at by default, in pixels. NumPy: its passes hold about
 #: 40 float32 values per pixel at once, so 512 x 512 keeps a tile near 50 MB and in
-#: cache-friendly pieces. GL: the passes keep about 110 bytes of textures per pixel, so a
-#: 2048 x 2048 tile holds ~450 MB, and ``aarecovery recover`` on a 4096 x 4096 RGB pair
-#: peaks at 1.2 GB in all (4096 tiles: 1.9 GB, measured); larger tiles gained no speed on
-#: llvmpipe.
-DEFAULT_TILES = {"gl": 2048, "numpy": 512}
+#: cache-friendly pieces. GL on a CPU renderer (llvmpipe, whose textures are in main memory):
+#: 1024, measured with ``aarecovery recover --paper`` on a 4096 x 4096 RGB pair (3 runs,
+#: CPU seconds, peak memory): 1024 took 1.5-1.9 s and 0.34 GB, 2048 1.6-1.9 s and 0.46 GB,
+#: one 4096 tile 2.2-2.4 s and 1.8 GB. GL on a GPU: 2048, where tiles cost only transfers
+#: and dispatches (not measured on a GPU since tiles became equal in size).
+DEFAULT_TILES = {"gl": 2048, "gl-software": 1024, "numpy": 512}
 #: The smallest tile side worth running. Each tile recomputes its halo and pays a fixed
 #: cost (an upload and a set of passes on GL). On a 768 x 512 pair, paper mode, 3
 #: iterations (halo 4), against the default tiles: GL 32 px 3.1x the time, 48 px 1.5x,
@@ -85,26 +86,40 @@ def check_tile_size(tile_size, iterations, name="tile_size", image_size=None):
     return int(tile_size)
 
 
+def _spans(length, tile, halo):
+    """``(inner, outer)`` slices along one axis: even inner parts, outer windows of one width."""
+    if length <= tile:
+        return [(slice(0, length), slice(0, length))]
+    step = tile - 2 * halo
+    count = -(-length // step)
+    bounds = [part * length // count for part in range(count + 1)]
+    # The widest part with its halo on both sides; every window gets this width, shifted
+    # inwards at the image's borders, where it then holds more than the halo.
+    window = min(length, max(b - a for a, b in zip(bounds, bounds[1:])) + 2 * halo)
+    return [(slice(start, stop), slice(min(max(0, start - halo), length - window),
+                                       min(max(0, start - halo), length - window) + window))
+            for start, stop in zip(bounds, bounds[1:])]
+
+
 def tiles(height, width, tile, halo):
     """Split an image into tiles with halos.
+
+    The image is split into as few tiles as fit in `tile` with their halos, of nearly equal
+    sizes, and every tile loads a window of the same shape (larger than its part and halo
+    where it meets the image's border): a backend then allocates its buffers once per image,
+    and no tile is a sliver. Any window holding the part and its halo gives the untiled
+    result there.
 
     Yields
     ------
     inner : tuple of slice
         The rows and columns this tile decides.
     outer : tuple of slice
-        The rows and columns to load: `inner` grown by `halo`, clipped to the image.
+        The rows and columns to load: `inner` grown by at least `halo` where the image
+        allows, at most `tile` a side, the same shape for every tile.
     """
-    step = tile - 2 * halo
-    if step < 1:
+    if tile - 2 * halo < 1:
         raise ValueError(f"tile size {tile} leaves no interior with a halo of {halo}")
-    if height <= tile and width <= tile:
-        whole = (slice(0, height), slice(0, width))
-        yield whole, whole
-        return
-    for top in range(0, height, step):
-        for left in range(0, width, step):
-            bottom, right = min(top + step, height), min(left + step, width)
-            yield ((slice(top, bottom), slice(left, right)),
-                   (slice(max(0, top - halo), min(height, bottom + halo)),
-                    slice(max(0, left - halo), min(width, right + halo))))
+    for rows, outer_rows in _spans(height, tile, halo):
+        for columns, outer_columns in _spans(width, tile, halo):
+            yield (rows, columns), (outer_rows, outer_columns)

@@ -1,8 +1,10 @@
 """Test options shared by the whole suite.
 
 ``--backend numpy|gl|all`` picks which backends the backend-parametrised tests run on
-(kornia-style: every such test body runs once per backend). GL tests never skip quietly:
-when no OpenGL context can be made they fail in CI (CI=true) and skip loudly elsewhere.
+(kornia-style: every such test body runs once per backend), and ``--gl-path
+fragment|compute|all`` which GL paths the tests taking ``gl_path`` run on (module-scoped,
+so that a module's engine is made once per path). GL tests never skip quietly: when no
+OpenGL context can be made they fail in CI (CI=true) and skip loudly elsewhere.
 """
 
 import os
@@ -10,11 +12,14 @@ import os
 import pytest
 
 BACKEND_NAMES = ("numpy", "gl")
+GL_PATH_NAMES = ("fragment", "compute")
 
 
 def pytest_addoption(parser):
     parser.addoption("--backend", default="all", choices=("all",) + BACKEND_NAMES,
                      help="run backend-parametrised tests on this backend only (default: all)")
+    parser.addoption("--gl-path", default="all", choices=("all",) + GL_PATH_NAMES,
+                     help="run GL-path-parametrised tests on this path only (default: all)")
 
 
 def pytest_generate_tests(metafunc):
@@ -22,6 +27,9 @@ def pytest_generate_tests(metafunc):
         chosen = metafunc.config.getoption("--backend")
         names = BACKEND_NAMES if chosen == "all" else (chosen,)
         metafunc.parametrize("backend", names)
+    if "gl_path" in metafunc.fixturenames:
+        chosen = metafunc.config.getoption("--gl-path")
+        metafunc.parametrize("gl_path", GL_PATH_NAMES if chosen == "all" else (chosen,), scope="module")
 
 
 _gl_problem = None
@@ -52,6 +60,6 @@ def require_gl():
 
 @pytest.fixture(autouse=True)
 def _gl_needed(request):
-    if request.node.get_closest_marker("gl") or getattr(request.node, "callspec", None) \
-            and request.node.callspec.params.get("backend") == "gl":
+    params = getattr(request.node, "callspec", None) and request.node.callspec.params or {}
+    if request.node.get_closest_marker("gl") or params.get("backend") == "gl" or "gl_path" in params:
         require_gl()

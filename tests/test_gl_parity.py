@@ -1,4 +1,4 @@
-"""The GL backend against its NumPy twin, pass by pass.
+"""The GL backend against its NumPy twin, pass by pass, on both GL paths (fragment and compute).
 
 Stated tolerances: the working-space textures within 1e-6 relative (float32 rounding of the same
 sRGB formula); edge strength within 1e-5 relative; beta and residual within 1e-5; the
@@ -49,21 +49,30 @@ def _numpy_model(original, filtered, blend_space="linear", linear=False):
 
 
 @pytest.fixture(scope="module")
-def gl_engine():
-    engine = aarecovery.Engine(backend="gl")
+def gl_engine(gl_path):
+    engine = aarecovery.Engine(backend="gl", gl_path=gl_path)
+    assert engine.gl_path == gl_path
     yield engine
     engine.release()
 
 
+def _working_textures(engine):
+    """O and F in the working space, read back as float32 RGBA."""
+    impl = engine._impl
+    with engine.context:
+        impl._to_working_space()  # over the whole image; runs keep to the blocks they read
+        textures = impl._working_textures()
+        return [np.frombuffer(impl._framebuffer([texture]).read(components=4, dtype="f4"), np.float32)
+                for texture in textures]
+
+
 @pytest.mark.parametrize("name, original, filtered", PAIRS, ids=IDS)
-def test_to_working_space(gl_engine, name, original, filtered):
-    gl_engine.set_images(original, filtered, blend_space="linear")
-    expected_o, expected_f, _ = _numpy_model(original, filtered)
-    for key, expected in (("original_work", expected_o), ("filtered_work", expected_f)):
-        with gl_engine.context:
-            raw = gl_engine._impl._textures[key].read()
-        actual = np.frombuffer(raw, np.float32).reshape(expected.shape)
-        np.testing.assert_allclose(actual, expected, rtol=1e-6, atol=1e-7)
+@pytest.mark.parametrize("blend_space", ["linear", "srgb"])
+def test_to_working_space(gl_engine, name, original, filtered, blend_space):
+    gl_engine.set_images(original, filtered, blend_space=blend_space)
+    expected_o, expected_f, _ = _numpy_model(original, filtered, blend_space)
+    for actual, expected in zip(_working_textures(gl_engine), (expected_o, expected_f)):
+        np.testing.assert_allclose(actual.reshape(expected.shape), expected, rtol=1e-6, atol=1e-7)
 
 
 @pytest.mark.parametrize("name, original, filtered", PAIRS, ids=IDS)
@@ -118,18 +127,18 @@ def test_engine_reuse_matches_fresh_runs(gl_engine):
     for sigma_d, sigma_e, iterations in [(0.1, 0.01, 3), (0.05, 0.02, 2), (0.2, 0.005, 4)]:
         again = gl_engine.recover(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode="paper")
         fresh = aarecovery.recover(original, filtered, sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations,
-                                   backend="gl", mode="paper")
+                                   backend="gl", mode="paper", gl_path=gl_engine.gl_path)
         np.testing.assert_array_equal(again, fresh)
 
 
-def test_borrowed_context_state_is_restored():
+def test_borrowed_context_state_is_restored(gl_path):
     import moderngl
     context = moderngl.create_standalone_context(backend="egl")
     try:
         screen = context.simple_framebuffer((8, 8))
         screen.use()
         context.enable(moderngl.BLEND)
-        engine = aarecovery.Engine(backend="gl", context=context)
+        engine = aarecovery.Engine(backend="gl", context=context, gl_path=gl_path)
         _, original, filtered = PAIRS[0]
         engine.set_images(original, filtered)
         blended = engine.recover(mode="paper")
@@ -197,19 +206,25 @@ def test_switching_modes_on_one_engine(gl_engine):
         np.testing.assert_allclose(maps.edge_strength, expected_maps.edge_strength, rtol=1e-5, atol=1e-7)
 
 
+def _list_lengths(engine, image_name):
+    from gl_blocks import gpu_lists
+    with engine.context:
+        return {name: len(blocks) for name, blocks in gpu_lists(engine._impl, image_name).items()}
+
+
 @pytest.mark.parametrize("mode", ["paper", "safe"])
 def test_block_passes_match_whole_image_passes(gl_engine, mode):
-    # The fit and inner Jacobi passes draw only blocks where the edge strength can be non-zero
-    # (F not flat; O not flat with pure colours). A few features in a large flat image, so that
-    # most blocks are skipped, must give the NumPy result everywhere.
+    # The fit and inner Jacobi passes cover only blocks where the edge strength can be non-zero
+    # (F not flat; O not flat with pure colours), the rest gets F. A few features in a large
+    # flat image, so that most blocks are skipped, must give the NumPy result everywhere.
     from aarecovery.backends.gl.blocks import BLOCK_SIDE
     original, filtered = _sparse_pair()
     actual = aarecovery.recover(original, filtered, engine=gl_engine, mode=mode)
-    counts = {name: count for name, (count, _) in gl_engine._impl._blocks.items()}
     total = -(-160 // BLOCK_SIDE) * -(-176 // BLOCK_SIDE)
-    assert 0 < counts["filtered"] < total / 2
-    if mode == "safe":  # pure colours draw O's blocks, found when first needed
-        assert 0 < counts["original"] < total / 2
+    lengths = _list_lengths(gl_engine, "filtered")
+    assert 0 < lengths["active"] < total / 2 and lengths["active"] + lengths["inactive"] == total
+    if mode == "safe":  # pure colours cover O's blocks, found when first needed
+        assert 0 < _list_lengths(gl_engine, "original")["active"] < total / 2
     expected = aarecovery.recover(original, filtered, backend="numpy", mode=mode)
     assert np.abs(actual.astype(np.int64) - expected).max() <= 1
 
@@ -249,3 +264,41 @@ def test_luminance_keyed_tables_agree(gl_engine, weights):
     expected = aarecovery.recover(original, filtered, backend="numpy")
     assert np.abs(actual.astype(np.int64) - expected).max() <= 1
     assert np.abs(expected.astype(np.int64) - filtered).max() > 16
+
+
+@pytest.mark.parametrize("overlap_readback", [False, True])
+@pytest.mark.parametrize("compute_classification", [True, False])
+def test_transfer_and_classification_variants_agree(gl_path, overlap_readback, compute_classification):
+    # Pixel-buffer readbacks (what a GPU does, overlapping the next tile) and the block
+    # classification of GL 3.3 to 4.2 (a GPU block mask, listed on the CPU), forced on llvmpipe.
+    engine = aarecovery.Engine(backend="gl", gl_path=gl_path)
+    try:
+        engine._impl._overlap_readback = overlap_readback
+        engine._impl._classifier.compute = compute_classification
+        for _, original, filtered in PAIRS[1:5] + [("sparse",) + _sparse_pair()]:
+            for mode, tile_size in (("paper", 23), ("safe", None)):
+                actual = aarecovery.recover(original, filtered, engine=engine, mode=mode, tile_size=tile_size)
+                expected = aarecovery.recover(original, filtered, backend="numpy", mode=mode)
+                tolerance = {np.dtype(np.uint8): 1, np.dtype(np.uint16): 2}.get(actual.dtype, 1e-5)
+                assert np.abs(actual.astype(np.float64) - expected).max() <= tolerance
+    finally:
+        engine.release()
+
+
+def test_shared_memory_fit_agrees():
+    # The compute path's fit with its neighbourhoods in shared memory (off by default: slower
+    # on llvmpipe, see paths.py), against the NumPy model and result.
+    engine = aarecovery.Engine(backend="gl", gl_path="compute")
+    try:
+        engine._impl.shared_tile = True
+        for _, original, filtered in PAIRS:
+            engine.set_images(original, filtered, blend_space="linear")
+            engine.compute(mode="paper", maps=True)
+            _, _, expected = _numpy_model(original, filtered)
+            np.testing.assert_allclose(engine.maps().beta, expected.beta, rtol=0, atol=1e-5)
+            actual = engine.result()
+            reference = aarecovery.recover(original, filtered, backend="numpy", mode="paper", blend_space="linear")
+            tolerance = {np.dtype(np.uint8): 1, np.dtype(np.uint16): 2}.get(actual.dtype, 1e-5)
+            assert np.abs(actual.astype(np.float64) - reference).max() <= tolerance
+    finally:
+        engine.release()

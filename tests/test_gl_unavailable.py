@@ -57,7 +57,7 @@ def assert_one_line(done, prefix):
     ["filter", "threshold", "{o}", "-o", "{out}/r.png", "--recover", "--backend", "gl"],
     ["demo", "-o", "{out}/demo", "--backend", "gl"],
     ["eval", "--quick", "--no-peers", "--scenes", "text", "--filters", "threshold", "--backend", "gl"],
-    ["bench", "--backends", "gl", "--sizes", "32x32", "--runs", "1"],
+    ["bench", "--configs", "gl-fragment", "--sizes", "32x32", "--runs", "1"],
 ], ids=lambda command: command[0])
 def test_commands_fail_in_one_line_with_backend_gl(pair, tmp_path, command):
     names = {"o": pair / "o.png", "f": pair / "f.png", "out": tmp_path}

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from aarecovery import colour
+from aarecovery.backends.gl import blocks
 from aarecovery.backends.gl.glsl import read_source
 from aarecovery.spec import blend_model, pure_colours
 
@@ -21,6 +22,16 @@ TWINS = {
     ("pure_colours.glsl", "MIN_REACH"): pure_colours.MIN_REACH,
     ("blend_model.glsl", "TINY"): float(blend_model._TINY),
     ("blend_model.glsl", "FAINT"): float(blend_model._FAINT),
+    ("classify_blocks.comp", "MARGIN"): blocks.MARGIN,
+    ("classify_blocks.comp", "BLOCK_SIDE"): blocks.BLOCK_SIDE,
+    ("classify_blocks.frag", "MARGIN"): blocks.MARGIN,
+    ("classify_blocks.frag", "BLOCK_SIDE"): blocks.BLOCK_SIDE,
+    ("block_lists.glsl", "DRAW_COMMAND_WORDS"): blocks.DRAW_COMMAND_WORDS,
+    ("block_lists.glsl", "DISPATCH_COMMAND_WORDS"): blocks.DISPATCH_COMMAND_WORDS,
+    ("block_lists.glsl", "LIST_ACTIVE"): blocks.LISTS.index("active"),
+    ("block_lists.glsl", "LIST_DILATED"): blocks.LISTS.index("dilated"),
+    ("block_lists.glsl", "LIST_INACTIVE"): blocks.LISTS.index("inactive"),
+    ("block_lists.glsl", "LIST_COUNT"): len(blocks.LISTS),
 }
 
 
@@ -45,3 +56,8 @@ def test_palette_array_holds_the_palette_size():
 
 def test_em_iterations_match():
     assert f"iteration < {blend_model._EM_ITERATIONS};" in read_source("blend_model.glsl")
+
+
+def test_compute_block_side_matches():
+    # A define there: GLSL 4.30 takes only literals in a work group's size.
+    assert f"#define BLOCK_SIDE {blocks.BLOCK_SIDE} " in read_source("compute.glsl")

@@ -394,7 +394,7 @@ def test_interrupted_png_encoder_leaves_no_trace(tmp_path, monkeypatch):
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(imagecodecs, "png_encode", interrupted)
+    monkeypatch.setattr(imagecodecs, "deflate_encode", interrupted)
     with pytest.raises(KeyboardInterrupt):
         write_image(tmp_path / "new.png", random_image((3, 4), np.uint8))
     assert folder_listing(tmp_path) == []

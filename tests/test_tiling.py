@@ -34,12 +34,37 @@ def test_tiled_maps_equal_untiled(backend):
         np.testing.assert_array_equal(getattr(tiled, name), getattr(whole, name))
 
 
-def test_tiles_cover_the_image_once():
-    covered = np.zeros((53, 71), int)
-    for inner, outer in tiles(53, 71, tile=20, halo=3):
+@pytest.mark.parametrize("mode", ["paper", "safe"])
+def test_tiles_equal_untiled_on_each_gl_path(gl_path, mode):
+    # Equal-sized tiles of several sizes (a backend keeps its textures between them), with the
+    # pure colours of the safe default on thin features too.
+    from aarecovery.lab import scenes
+    from aarecovery.lab.groundtruth import make_case
+    case = make_case(scenes.render("lines", 60, 4), "posterize", 4, "srgb")
+    thin = [np.rint(image * 255).astype(np.uint8) for image in (case.original, case.filtered)]
+    shaped = shapes(90, seed=4, noise=0.02)[:, :77]
+    for original, filtered in (thin, (shaped, np.where(shaped > 100, 255, 0).astype(np.uint8))):
+        with aarecovery.Engine(backend="gl", gl_path=gl_path) as engine:
+            whole = aarecovery.recover(original, filtered, engine=engine, mode=mode)
+            for tile_size in (11, 19, 40):
+                tiled = aarecovery.recover(original, filtered, engine=engine, mode=mode, tile_size=tile_size)
+                np.testing.assert_array_equal(tiled, whole)
+
+
+@pytest.mark.parametrize("height, width, tile, halo", [(53, 71, 20, 3), (4096, 4096, 1024, 4), (100, 30, 20, 4),
+                                                       (12, 12, 11, 5), (7, 300, 40, 2)])
+def test_tiles_cover_the_image_once_in_windows_of_one_shape(height, width, tile, halo):
+    covered = np.zeros((height, width), int)
+    shapes_seen = set()
+    for inner, outer in tiles(height, width, tile=tile, halo=halo):
         covered[inner] += 1
-        assert outer[0].start <= inner[0].start and outer[0].stop >= inner[0].stop
+        for part, window, length in zip(inner, outer, (height, width)):
+            assert 0 <= window.start <= max(0, part.start - halo)
+            assert min(length, part.stop + halo) <= window.stop <= length
+            assert window.stop - window.start <= tile
+        shapes_seen.add(tuple(window.stop - window.start for window in outer))
     assert (covered == 1).all()
+    assert len(shapes_seen) == 1
 
 
 def test_too_small_a_tile_is_refused():

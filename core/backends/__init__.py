@@ -8,7 +8,7 @@ NumPy with a one-line warning when no OpenGL 3.3 context can be made.
 import warnings
 
 from ..errors import BackendFallbackWarning, InputError
-from ..params import check_backend
+from ..params import check_backend, check_gl_path
 from .base import Backend, Capabilities, Plan, RecoveryMaps
 from .gl.context import GLUnavailable
 
@@ -20,12 +20,12 @@ def _numpy():
     return NumpyBackend()
 
 
-def _gl(context):
+def _gl(context, gl_path):
     from .gl.backend import GLBackend
-    return GLBackend(context)
+    return GLBackend(context, gl_path)
 
 
-def make_backend(name="auto", context=None):
+def make_backend(name="auto", context=None, gl_path="auto"):
     """A backend by name.
 
     Parameters
@@ -33,6 +33,9 @@ def make_backend(name="auto", context=None):
     name : {"auto", "gl", "numpy"}
     context : moderngl.Context, optional
         A GL context to borrow (a viewer's window); only with ``"gl"`` or ``"auto"``.
+    gl_path : {"auto", "fragment", "compute"}
+        How the GL backend runs its passes (``aarecovery.params.GL_PATHS``); only
+        ``"auto"`` with ``"numpy"``.
 
     Returns
     -------
@@ -42,14 +45,20 @@ def make_backend(name="auto", context=None):
     ------
     GLUnavailable
         With ``"gl"`` when no OpenGL 3.3 context can be made.
+    InputError
+        For ``gl_path="compute"`` where the context has no OpenGL 4.3.
     """
     check_backend(name)
+    check_gl_path(gl_path)
     if name == "numpy":
         if context is not None:
             raise InputError("a GL context was passed with backend='numpy'; pass backend='gl' or drop the context")
+        if gl_path != "auto":
+            raise InputError(f"gl_path={gl_path!r} was passed with backend='numpy'; pass backend='gl' or drop "
+                             "the gl_path")
         return _numpy()
     try:
-        return _gl(context)
+        return _gl(context, gl_path)
     except GLUnavailable as error:
         if name == "gl":
             raise

@@ -10,7 +10,7 @@ from typing import Protocol
 
 import numpy as np
 
-__all__ = ["Plan", "RecoveryMaps", "Capabilities", "Backend"]
+__all__ = ["Plan", "RecoveryMaps", "Capabilities", "Backend", "ReadyResult"]
 
 
 @dataclass(frozen=True)
@@ -86,10 +86,30 @@ class Capabilities:
         The largest tile side it can hold (a texture limit for GL).
     default_tile : int
         The tile side it runs best at (measured; see ``docs/performance.md``).
+    gl_paths : tuple of str
+        The ways it can run the passes on OpenGL (``aarecovery.params.GL_PATHS``): empty for
+        NumPy, ``("fragment",)`` before GL 4.3, ``("fragment", "compute")`` from GL 4.3 on.
+    gl_path : str or None
+        The one it runs, or None for NumPy.
     """
 
     max_tile: int
     default_tile: int
+    gl_paths: tuple = ()
+    gl_path: str = None
+
+
+class ReadyResult:
+    """A result that is already in memory: what :meth:`Backend.start_readback` gives where
+    reading back costs nothing or cannot overlap anything."""
+
+
+    def __init__(self, rgba):
+        self._rgba = rgba
+
+    def wait(self):
+        """ndarray: the result, as :meth:`Backend.start_readback` describes it."""
+        return self._rgba
 
 
 class Backend(Protocol):
@@ -98,6 +118,9 @@ class Backend(Protocol):
     The engine calls :meth:`load` once per image pair (or tile), then :meth:`run` once per
     plan, then reads back. Images arrive as the caller gave them (any layout and dtype the
     contract accepts, described by their ``Layout``); results go back as straight RGBA.
+    :meth:`load` and :meth:`run` may return before the work is done (a GPU's queue); a
+    tiled caller overlaps one tile's readback with the next tile's passes through
+    :meth:`start_readback`.
     """
 
     name: str
@@ -112,8 +135,11 @@ class Backend(Protocol):
     def finish(self):
         """Block until the last run is complete."""
 
-    def read_result(self):
-        """The last result as ``(H, W, 4)`` straight RGBA: float32, or F's integer dtype."""
+    def start_readback(self, window=None):
+        """Start reading the last result back (the part `window`, a pair of row and column
+        slices, or all of it); return an object whose ``wait()`` gives it: ``(h, w, 4)``
+        straight RGBA in float32 or F's integer dtype, or ``(h, w, C)`` in F's own channels
+        and dtype. It stays valid while one more result is started."""
 
     def read_maps(self):
         """The maps of the last run with ``maps=True``, as :class:`RecoveryMaps`."""

@@ -5,7 +5,7 @@ import numpy as np
 from ..contract import to_rgba_float
 from ..spec import BlendModel, from_working_space, recover_working, to_working_space
 from ..tiling import DEFAULT_TILES, halo_for
-from .base import Capabilities, RecoveryMaps
+from .base import Capabilities, ReadyResult, RecoveryMaps
 
 __all__ = ["NumpyBackend"]
 # The passes run on strips of rows: their ~40 temporary planes then stay in cache, which
@@ -58,8 +58,8 @@ class NumpyBackend:
     def finish(self):
         pass
 
-    def read_result(self):
-        return self._result
+    def start_readback(self, window=None):
+        return ReadyResult(self._result if window is None else self._result[window])
 
     def read_maps(self):
         m = self._model

@@ -1,10 +1,10 @@
-"""``aarecovery bench``: end-to-end throughput of each backend, and the peak memory of ``recover``."""
+"""``aarecovery bench``: each stage of a recovery per GL path and NumPy, and whole ``recover`` processes."""
 
 import argparse
 import json
 
 from ..errors import InputError
-from ..lab.bench import DEFAULT_SIZES
+from ..lab.bench import CONFIGS, DEFAULT_CONFIGS, DEFAULT_SIZES
 
 __all__ = ["register", "run"]
 
@@ -19,13 +19,22 @@ def _size(text):
     return width, height
 
 
+def _configs(text):
+    configs = text.split(",")
+    unknown = [config for config in configs if config not in CONFIGS]
+    if unknown:
+        raise InputError(f"unknown configuration {unknown[0]!r}; choose from {', '.join(CONFIGS)}")
+    return configs
+
+
 def run(args):
     """Run ``aarecovery bench`` with parsed arguments; return the exit status."""
     from ..lab.bench import run_bench
 
-    report = run_bench([_size(size) for size in args.sizes.split(",")], args.backends.split(","),
-                       args.filters.split(","), args.runs, safe=args.safe,
-                       memory=_size(args.memory) if args.memory else None,
+    if args.runs < 1:
+        raise InputError(f"--runs must be at least 1, got {args.runs}")
+    report = run_bench([_size(size) for size in args.sizes.split(",")], _configs(args.configs),
+                       args.filters.split(","), args.runs, process=_size(args.process) if args.process else None,
                        log=lambda line: print(line, flush=True))
     if args.json:
         with open(args.json, "w") as out:
@@ -35,26 +44,28 @@ def run(args):
 
 def register(subparsers):
     parser = subparsers.add_parser(
-        "bench", help="measure the throughput of each backend",
-        description="End-to-end throughput (upload, passes, readback) of each backend in megapixels "
-                    "per second: the median of several runs after a warm-up, on a generated photo-like "
-                    "8-bit RGB pair, with the GL/NumPy ratio from the same run.",
-        epilog="examples:\n  aarecovery bench\n  aarecovery bench --sizes 1920x1080 --backends gl --runs 9\n"
-               "  aarecovery bench --memory 4096x4096 --json bench.json",
+        "bench", help="measure each stage of a recovery, per GL path and NumPy",
+        description="Times the stages of a file-to-file recovery (decode, plan, upload, classify, passes, "
+                    "readback, encode) on a generated photo-like 8-bit RGB pair, and the end-to-end throughput "
+                    "of each engine configuration in megapixels per second (the paper's method and the safe "
+                    "default), medians of several runs after a warm-up; ratios come from one run. --process "
+                    "also times whole 'aarecovery recover' processes file to file, with their peak memory.",
+        epilog="examples:\n  aarecovery bench\n  aarecovery bench --sizes 3840x2160 --filters gamma --configs gl-compute\n"
+               "  aarecovery bench --process --json bench.json",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes", default=",".join(f"{w}x{h}" for w, h in DEFAULT_SIZES),
                         help="comma-separated WIDTHxHEIGHT list (default %(default)s)")
-    parser.add_argument("--backends", default="gl,numpy", help="comma-separated (default %(default)s)")
+    parser.add_argument("--configs", default=",".join(DEFAULT_CONFIGS),
+                        help=f"comma-separated, from {', '.join(CONFIGS)} (default %(default)s; gl-compute-shared "
+                             "keeps the fit's neighbourhoods in shared memory)")
     parser.add_argument("--filters", default="threshold,gamma",
                         help="threshold (flat F away from edges) and/or gamma (every pixel fitted); "
                              "default %(default)s")
-    parser.add_argument("--runs", type=int, default=5, help="timed GL runs per size; NumPy gets half "
+    parser.add_argument("--runs", type=int, default=5, help="timed runs per figure; NumPy gets a third "
                         "(default %(default)s)")
-    parser.add_argument("--safe", action="store_true",
-                        help="also time the default mode, whose per-image analysis runs in NumPy")
-    parser.add_argument("--memory", metavar="WxH", nargs="?", const="4096x4096",
-                        help="also measure the peak memory of 'aarecovery recover' on a pair of this size "
-                             "(default when given without a value: 4096x4096)")
+    parser.add_argument("--process", metavar="WxH", nargs="?", const="4096x4096",
+                        help="also time whole 'aarecovery recover' processes on a thresholded pair of PNG files "
+                             "of this size, with peak memory (default when given without a value: 4096x4096)")
     parser.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
     parser.set_defaults(run=run)
     return parser

@@ -5,7 +5,7 @@ import os
 
 # Already imported with the package; the codecs and the engine's backends load in run().
 from ..errors import InputError
-from ..params import BACKENDS, BLEND_SPACES, PARAMETERS
+from ..params import BACKENDS, BLEND_SPACES, GL_PATHS, PARAMETERS
 from ..tiling import DEFAULT_TILES, SENSIBLE_TILE
 from .inputs import add_image_memory_option
 
@@ -57,6 +57,9 @@ def register(subparsers):
     add_parameter_options(parser)
     parser.add_argument("--backend", choices=BACKENDS, default="auto",
                         help="auto uses OpenGL and falls back to NumPy (default %(default)s)")
+    parser.add_argument("--gl-path", choices=GL_PATHS, default="auto",
+                        help="how the GL backend runs its passes: fragment shaders (OpenGL 3.3) or compute "
+                             "shaders (OpenGL 4.3); auto picks the faster for the device (default %(default)s)")
     parser.add_argument("--linear", action="store_true",
                         help="the images hold linear-light values (default: sRGB-encoded)")
     parser.add_argument("--blend-space", choices=BLEND_SPACES, default=None,
@@ -74,8 +77,9 @@ def register(subparsers):
     add_image_memory_option(parser)
     parser.add_argument("--tile-size", type=int, metavar="N",
                         help="largest tile side in pixels; larger images are processed in overlapping "
-                             f"tiles with the same result (default: {DEFAULT_TILES['gl']} on GL, "
-                             f"{DEFAULT_TILES['numpy']} on NumPy; at least {SENSIBLE_TILE})")
+                             f"tiles with the same result (default: {DEFAULT_TILES['gl']} on a GPU, "
+                             f"{DEFAULT_TILES['gl-software']} on a CPU renderer, {DEFAULT_TILES['numpy']} on "
+                             f"NumPy; at least {SENSIBLE_TILE})")
     parser.set_defaults(run=run)
     return parser
 
@@ -98,6 +102,19 @@ def _visible_map(values, scale):
     return np.rint(np.clip(scaled, 0, 1) * 65535).astype(np.uint16)
 
 
+def _read_pair(args):
+    """Decode both images in two threads: the codecs release the GIL."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from .inputs import check_pair_size, read_input
+
+    paths = (args.original, args.filtered)
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        original, filtered = pool.map(lambda path: read_input(path, args), paths)
+    check_pair_size(original, filtered, paths)
+    return original, filtered
+
+
 def run(args):
     """Run ``aarecovery recover`` with parsed arguments; return the exit status."""
     import time
@@ -107,7 +124,6 @@ def run(args):
     from ..params import Parameters
     from ..pipeline import recover
     from ..tiling import check_tile_size
-    from .inputs import check_pair_size, read_input
     from .outputs import check_destinations, remove_stale_parts_of
 
     params = Parameters(args.sigma_d, args.sigma_e, args.iterations)
@@ -125,11 +141,9 @@ def run(args):
     remove_stale_parts_of(outputs)
 
     # Before reading: a backend that cannot run (no OpenGL) says so at once.
-    engine = Engine(args.backend)
+    engine = Engine(args.backend, gl_path=args.gl_path)
     try:
-        original = read_input(args.original, args)
-        filtered = read_input(args.filtered, args)
-        check_pair_size(original, filtered, (args.original, args.filtered))
+        original, filtered = _read_pair(args)
         # Before the recovery, so that a long run does not end in a refusal.
         check_output_path(args.output, filtered.shape)
         start = time.perf_counter()

@@ -13,6 +13,7 @@ from ..errors import InputError, NotEnoughMemory
 from .formats import NPY_DTYPES, WRITE_FORMATS, import_codec, layout_name
 from .limits import format_bytes
 from .parts import create_part
+from .png import write_png
 
 __all__ = ["write_image", "write_images", "check_output_path", "check_writable_folder", "DiskError",
            "disk_error"]
@@ -148,8 +149,7 @@ def _encode(file, pixels, format_name):
         np.lib.format.write_array_header_1_0(file, np.lib.format.header_data_from_array_1_0(pixels))
         file.write(memoryview(np.ascontiguousarray(pixels)).cast("B"))
     elif format_name == "PNG":
-        imagecodecs = import_codec("imagecodecs", "PNG")
-        file.write(imagecodecs.png_encode(pixels))
+        write_png(file, pixels)
     elif format_name == "TIFF":
         tifffile = import_codec("tifffile", "TIFF")
         channels = 1 if pixels.ndim == 2 else pixels.shape[2]

@@ -1,9 +1,16 @@
-"""What ``aarecovery bench`` measures: end-to-end throughput of each backend, and peak memory of ``recover``.
+"""What ``aarecovery bench`` measures: each stage of a recovery, throughput per GL path and NumPy, whole processes.
 
-End to end means what a caller waits for: upload of O and F, every pass, and the readback of
-R. Each figure is the median of several runs after a warm-up run, in megapixels per second;
-the GL/NumPy ratio comes from the same run of the command, because the machines are shared
-and two runs of the same code differ by 15-20%.
+For each generated pair (:func:`bench_image_pair`) it times the stages a file-to-file run goes
+through: decode (both PNG files, in parallel as ``aarecovery recover`` does), plan (the safe
+default's analysis; the paper's method needs none), upload, classify (the active blocks, on
+the GPU), passes, readback (into F's layout), encode (the PNG file). Each engine
+configuration (:data:`CONFIGS`) also gets an end-to-end figure, as a caller waits for it:
+``set_images``, the passes and ``result``, uninstrumented, for the paper's method and the
+safe default (the plan made beforehand). With ``process``, whole ``aarecovery recover``
+processes are timed file to file, with their peak memory.
+
+Each figure is the median of several runs after a warm-up run; ratios come from one run of
+the command, because the machines are shared and two runs of the same code differ by 15-20%.
 """
 
 import os
@@ -13,15 +20,25 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections import defaultdict
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
 from ..colour import luma
 from ..errors import InputError
 
-__all__ = ["DEFAULT_SIZES", "bench_image_pair", "measure_throughput", "run_bench"]
+__all__ = ["DEFAULT_SIZES", "CONFIGS", "STAGES", "bench_image_pair", "run_bench"]
 
 DEFAULT_SIZES = ((1920, 1080), (4096, 4096))
+#: Engine configurations: the GL backend on each path (and the compute path with its fit's
+#: neighbourhoods in shared memory, off by default), and NumPy.
+CONFIGS = {"gl-fragment": dict(backend="gl", gl_path="fragment"), "gl-compute": dict(backend="gl", gl_path="compute"),
+           "gl-compute-shared": dict(backend="gl", gl_path="compute", shared_tile=True),
+           "numpy": dict(backend="numpy")}
+DEFAULT_CONFIGS = ("gl-fragment", "gl-compute", "numpy")
+#: The stages of a file-to-file recovery, in order.
+STAGES = ("decode", "plan", "upload", "classify", "passes", "readback", "encode")
 
 
 def bench_image_pair(width, height, filter_name="threshold", seed=0):
@@ -67,44 +84,148 @@ def bench_image_pair(width, height, filter_name="threshold", seed=0):
     return original, filtered
 
 
-def measure_throughput(engine, original, filtered, runs, mode="paper"):
-    """Median end-to-end seconds of ``set_images + compute + result`` after one warm-up run."""
+def _median_seconds(work, runs):
+    """Median seconds of `runs` calls of `work` after a warm-up call, and its last result."""
+    result = work()
     times = []
-    for run in range(runs + 1):
+    for _ in range(runs):
         start = time.perf_counter()
-        engine.set_images(original, filtered)
-        engine.compute(mode=mode)
-        engine.result()
-        if run:
-            times.append(time.perf_counter() - start)
-    return statistics.median(times)
+        result = work()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), result
 
 
-# Runs a command and prints the peak resident memory of its process tree. It runs in a small
-# Python of its own: a child forked from this (large) process would count this process's
-# pages in its own peak until it executes the command.
+class _StageClock:
+    """Adds up the seconds between the marks a backend makes (``GLBackend.stage_clock``)."""
+
+    def __init__(self):
+        self.seconds = defaultdict(float)
+        self._last = None
+
+    def start(self):
+        self._last = time.perf_counter()
+
+    def __call__(self, name):
+        now = time.perf_counter()
+        self.seconds[name] += now - self._last
+        self._last = now
+
+
+def _make_engine(config):
+    from ..engine import Engine
+    options = dict(CONFIGS[config])
+    shared_tile = options.pop("shared_tile", False)
+    engine = Engine(**options)
+    if shared_tile:
+        engine._impl.shared_tile = True
+    return engine
+
+
+def _stages(engine, original, filtered, plan, runs):
+    """Median seconds per stage of ``set_images + run + result``, each stage waited for."""
+    clock = _StageClock()
+    instrumented = hasattr(engine._impl, "stage_clock")
+    if instrumented:
+        engine._impl.stage_clock = clock
+    per_run = []
+    try:
+        for run in range(runs + 1):
+            clock.seconds.clear()
+            clock.start()
+            engine.set_images(original, filtered, blend_space=plan.blend_space)
+            if not instrumented:
+                clock("upload")
+            clock.start()
+            engine.run(plan)
+            if not instrumented:
+                clock("passes")
+            clock.start()
+            engine.result()
+            clock("readback")
+            if run:
+                per_run.append(dict(clock.seconds))
+    finally:
+        if instrumented:
+            engine._impl.stage_clock = None
+    return {stage: statistics.median(seconds.get(stage, 0.0) for seconds in per_run)
+            for stage in ("upload", "classify", "passes", "readback")}
+
+
+def _end_to_end(engine, original, filtered, plan, runs):
+    def recover():
+        engine.set_images(original, filtered, blend_space=plan.blend_space)
+        engine.run(plan)
+        return engine.result()
+    return _median_seconds(recover, runs)
+
+
+def _file_stages(original, filtered, runs):
+    """Median seconds to decode the pair's PNG files (in parallel) and to encode one."""
+    from ..io import read_image, write_image
+    with tempfile.TemporaryDirectory() as folder:
+        paths = [os.path.join(folder, name) for name in ("o.png", "f.png")]
+        encode, _ = _median_seconds(lambda: write_image(paths[1], filtered), runs)
+        write_image(paths[0], original)
+
+        def decode():
+            with ThreadPoolExecutor(max_workers=2) as pool:
+                return list(pool.map(read_image, paths))
+        decode_seconds, _ = _median_seconds(decode, runs)
+    return decode_seconds, encode
+
+
+# Runs a command and prints its seconds and the peak resident memory of its process tree.
+# It runs in a small Python of its own: a child forked from this (large) process would count
+# this process's pages in its own peak until it executes the command.
 _MEASURE = """
-import resource, subprocess, sys
+import resource, subprocess, sys, time
+start = time.perf_counter()
 subprocess.run(sys.argv[1:], check=True, stdout=subprocess.DEVNULL)
+seconds = time.perf_counter() - start
 peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-print(peak if sys.platform == "darwin" else peak * 1024)
+print(seconds, peak if sys.platform == "darwin" else peak * 1024)
 """
 
+#: What ``aarecovery recover`` is given for each configuration in whole-process runs.
+_PROCESS_OPTIONS = {"gl-fragment": ["--backend", "gl", "--gl-path", "fragment"],
+                    "gl-compute": ["--backend", "gl", "--gl-path", "compute"],
+                    "numpy": ["--backend", "numpy"]}
 
-def _peak_memory_of_recover(width, height):
-    """Peak resident memory (bytes) and seconds of ``aarecovery recover`` on a width x height RGB pair."""
+
+def _processes(width, height, configs, runs, log):
+    """Whole ``aarecovery recover`` processes, file to file, on a thresholded RGB pair of PNGs."""
     from ..io import write_image
     original, filtered = bench_image_pair(width, height)
+    rows = {}
     with tempfile.TemporaryDirectory() as folder:
         paths = [os.path.join(folder, name) for name in ("o.png", "f.png", "r.png")]
         write_image(paths[0], original)
         write_image(paths[1], filtered)
         del original, filtered
-        start = time.perf_counter()
-        measured = subprocess.run([sys.executable, "-c", _MEASURE, sys.executable, "-m", "aarecovery", "recover",
-                                   paths[0], paths[1], "-o", paths[2]], check=True, capture_output=True, text=True)
-        seconds = time.perf_counter() - start
-    return int(measured.stdout.strip()), seconds
+        runs_of = [(config, mode) for config in configs if config in _PROCESS_OPTIONS
+                   for mode in (("safe", "paper") if config != "numpy" else ("safe",))]
+        for config, mode in runs_of:
+            command = [sys.executable, "-m", "aarecovery", "recover", *paths[:2], "-o", paths[2],
+                       *_PROCESS_OPTIONS[config]] + (["--paper"] if mode == "paper" else [])
+            measured = []
+            for _ in range(runs if config != "numpy" else max(1, runs // 3)):
+                output = subprocess.run([sys.executable, "-c", _MEASURE, *command], check=True, capture_output=True,
+                                        text=True)
+                seconds, peak = output.stdout.split()
+                measured.append((float(seconds), int(peak)))
+            seconds = statistics.median(m[0] for m in measured)
+            peak = max(m[1] for m in measured)
+            rows[f"{config} {mode}"] = {"seconds": seconds, "mps": width * height / seconds / 1e6,
+                                        "peak_bytes": peak, "runs": len(measured)}
+            log(f"  {config:12s} {mode:5s}  {seconds:6.2f} s  {width * height / seconds / 1e6:6.2f} MP/s  "
+                f"peak {peak / 2**30:.2f} GiB  ({len(measured)} runs)")
+    numpy_seconds = rows.get("numpy safe", {}).get("seconds")
+    if numpy_seconds:
+        for key, row in rows.items():
+            if key != "numpy safe":
+                row["ratio_to_numpy"] = numpy_seconds / row["seconds"]
+                log(f"  {key} / numpy safe: {row['ratio_to_numpy']:.1f}x")
+    return {"size": f"{width}x{height}", "filter": "threshold", "rows": rows}
 
 
 def _machine():
@@ -117,68 +238,86 @@ def _machine():
     return f"{model}, {cores} cores, Python {platform.python_version()}"
 
 
-def run_bench(sizes, backends, filters, runs, *, safe=False, memory=None, log=print):
-    """Measure each backend on generated pairs; return the report printed line by line to `log`.
+def _log_row(log, config, figures, pixels):
+    stages = figures["stages"]
+    cells = "  ".join(f"{stages[stage] * 1000:8.1f}" for stage in ("upload", "classify", "passes", "readback"))
+    log(f"  {config:18s}{cells}  {figures['passes_mps']:9.1f}  {figures['paper_mps']:8.2f}  "
+        f"{figures['safe_mps']:8.2f}")
+
+
+def run_bench(sizes, configs, filters, runs, *, process=None, log=print):
+    """Measure every stage and configuration on generated pairs; return the report.
 
     Parameters
     ----------
     sizes : list of (int, int)
         ``(width, height)`` pairs.
-    backends : list of str
-        Backend names; one that cannot start is reported, not fatal.
+    configs : list of str
+        Keys of :data:`CONFIGS`; one that cannot start (no GL 4.3 for the compute path) is
+        reported, not fatal.
     filters : list of str
         ``"threshold"`` and/or ``"gamma"`` (see :func:`bench_image_pair`).
     runs : int
-        Timed GL runs per size; NumPy gets half.
-    safe : bool
-        Also time the default mode.
-    memory : (int, int), optional
-        Also measure the peak memory of ``aarecovery recover`` at this size.
+        Timed runs per figure after a warm-up; NumPy gets a third.
+    process : (int, int), optional
+        Also time whole ``aarecovery recover`` processes at this size, with peak memory.
+    log : callable
+        Gets the report line by line.
 
     Returns
     -------
     dict
-        ``machine``, ``gl_renderer``, ``results`` (one row per filter and size, MP/s per
-        backend and the GL/NumPy ratio) and ``memory``.
+        ``machine``, ``gl_renderer``, ``results`` (per filter and size: the decode, plan and
+        encode seconds, and per configuration the stage seconds, the passes' megapixels per
+        second (classify and passes) and end-to-end megapixels per second for the paper's
+        method and the safe default) and ``process``.
     """
-    from ..engine import Engine
+    from ..params import Parameters
+    from ..plan import make_plan
     report = {"machine": _machine(), "results": []}
     log(f"machine: {report['machine']}")
     engines = {}
-    for name in backends:
+    for config in configs:
         try:
-            engines[name] = Engine(backend=name)
-        except InputError as error:  # a missing backend is reported, not fatal while another runs
-            if len(backends) == 1 or (not engines and name == backends[-1]):
+            engines[config] = _make_engine(config)
+        except InputError as error:  # a missing backend or path is reported, not fatal while another runs
+            if len(configs) == 1 or (not engines and config == configs[-1]):
                 raise
-            log(f"{name}: not available: {error}")
-    if "gl" in engines:
-        info = engines["gl"].context.info
+            log(f"{config}: not available ({error})")
+    gl = next((engine for engine in engines.values() if engine.backend == "gl"), None)
+    if gl is not None:
+        info = gl.context.info
         report["gl_renderer"] = f"{info['GL_RENDERER']} / {info['GL_VERSION']}"
         log(f"gl: {report['gl_renderer']}")
     for filter_name in filters:
         for width, height in sizes:
+            pixels = width * height
             original, filtered = bench_image_pair(width, height, filter_name)
-            row = {"filter": filter_name, "size": f"{width}x{height}"}
-            for name, engine in engines.items():
-                timed = runs if name == "gl" else max(1, runs // 2)
-                seconds = measure_throughput(engine, original, filtered, timed, mode="paper")
-                row[name] = width * height / seconds / 1e6
-                if name == "gl" and safe:
-                    safe_seconds = measure_throughput(engine, original, filtered, max(1, timed // 2), mode="safe")
-                    row["gl_safe"] = width * height / safe_seconds / 1e6
-            if "gl" in row and "numpy" in row:
-                row["ratio"] = row["gl"] / row["numpy"]
+            plan_seconds, safe = _median_seconds(
+                lambda: make_plan(original, filtered, Parameters(), mode="safe"), max(1, runs // 2))
+            paper = make_plan(original, filtered, Parameters(), mode="paper")
+            decode, encode = _file_stages(original, filtered, max(1, runs // 2))
+            row = {"filter": filter_name, "size": f"{width}x{height}", "decode_s": decode, "plan_s": plan_seconds,
+                   "encode_s": encode, "safe_plan": safe.reason, "configs": {}}
+            log(f"{filter_name} {width}x{height}: decode {decode:.3f} s, safe plan {plan_seconds:.3f} s "
+                f"({safe.blend_space}, strength {safe.strength:g}), encode {encode:.3f} s")
+            log(f"  {'ms (safe default)':18s}{'upload':>8s}  {'classify':>8s}  {'passes':>8s}  {'readback':>8s}  "
+                f"{'passes MP/s':>11s}  {'paper MP/s':>10s}  {'safe MP/s':>9s}")
+            for config, engine in engines.items():
+                timed = runs if engine.backend == "gl" else max(1, runs // 3)
+                stages = _stages(engine, original, filtered, safe, timed)
+                paper_seconds, _ = _end_to_end(engine, original, filtered, paper, timed)
+                safe_seconds, _ = _end_to_end(engine, original, filtered, safe, timed)
+                figures = {"stages": stages, "passes_mps": pixels / (stages["classify"] + stages["passes"]) / 1e6,
+                           "paper_mps": pixels / paper_seconds / 1e6, "safe_mps": pixels / safe_seconds / 1e6}
+                row["configs"][config] = figures
+                _log_row(log, config, figures, pixels)
             report["results"].append(row)
-            cells = "  ".join(f"{key} {value:7.2f}" + (" MP/s" if key != "ratio" else "x")
-                              for key, value in row.items() if isinstance(value, float))
-            log(f"{filter_name:9s} {width}x{height:<6d} {cells}")
     for engine in engines.values():
         engine.release()
-    if memory:
-        width, height = memory
-        peak, seconds = _peak_memory_of_recover(width, height)
-        report["memory"] = {"size": f"{width}x{height}", "peak_bytes": peak, "seconds": seconds}
-        log(f"peak memory of 'aarecovery recover' on a {width}x{height} RGB pair: {peak / 2**30:.2f} GiB "
-            f"({seconds:.1f} s)")
+    if process:
+        width, height = process
+        log(f"whole 'aarecovery recover' processes, {width}x{height} thresholded RGB PNG pair, file to file:")
+        report["process"] = _processes(width, height, [config for config in configs if config in _PROCESS_OPTIONS],
+                                       runs, log)
     return report

@@ -1,28 +1,38 @@
-"""The GL backend behind :class:`aarecovery.Engine`: GLSL 3.30 fragment passes on moderngl.
+"""The GL backend behind :class:`aarecovery.Engine`: the passes on moderngl, as fragment or compute shaders.
 
 Passes (each has a NumPy twin of the same name in ``aarecovery.spec.passes``):
 
-0. ``to_working_space``, once per image pair: O and F decoded and premultiplied into float
-   textures, so that parameter changes never decode again.
+0. ``to_working_space``: O and F decoded and premultiplied into float textures, where the
+   passes read them (the active blocks and those around them), once per image pair and
+   block list, so that parameter changes never decode again. Opaque 8 and 16-bit inputs
+   whose working space is their own encoding need no pass: the passes read the uploaded
+   textures, whose texel values are exactly what the pass would store.
 1. ``fit_blend_model``: O and F neighbourhoods -> model (alpha, beta, extremes, residual)
    and the first Jacobi iterate, which needs no pass of its own because the F texels it
    gathers were already fetched for Sobel.
 2. ``jacobi_step`` (iterations 2..n), the last one fused with ``from_working_space``.
-3. ``from_working_space`` alone only for 0 or 1 iterations.
+3. ``keep_filtered``: R = F wherever the recovery leaves F as it is.
 
-Only the blocks of 16 x 16 pixels where the edge strength can be non-zero are drawn by the
-fit and the inner Jacobi passes (``blocks.vert``): where F is not flat for the paper's
-model, where O is not flat with pure colours (whose edge strength does not need F's
-gradient). Elsewhere beta is 0 and R = F, which the textures hold from the moment the pair
-is loaded. On llvmpipe, which shades every
-covered fragment, this is what makes mostly flat results (threshold, posterize) fast; a GPU
-skips those pixels in the shader's early exit anyway.
+Passes 1 and 2 cover only the blocks of 16 x 16 pixels where the edge strength can be
+non-zero (``blocks.py``): where F is not flat for the paper's model, where O is not flat with
+pure colours (whose edge strength does not need F's gradient). Pass 3 covers the other
+blocks. The block lists are made on the GPU right after the upload (``classify.py``) and
+drive the draws and dispatches indirectly. On llvmpipe, which shades every covered
+fragment, this is what makes mostly flat results (threshold, posterize) fast; on a GPU it
+saves the work of idle lanes.
+
+Each pass runs as a fragment pass or as a compute pass (``paths.py``), chosen by capability
+and a measured rule, or by the caller (``gl_path``).
 
 Colour conversion happens on fetch, in the shader (colour.glsl), for every bit depth.
 sRGB textures would decode 8-bit inputs for free, but llvmpipe's decode is off by up to
 1.2e-3 from the exact curve, and the fit's argmax and 3 sigma_d decisions turn such errors
 into visible differences from the NumPy specification (up to 140/255 on noisy edges,
 measured); the exact shader decode matched NumPy on every test image.
+
+Textures and block lists are made once per image size and kept (``recover`` gives every
+tile the same size, ``aarecovery.tiling``); the result texture has F's bit depth, so an
+8-bit result is read back as 8-bit and a 16-bit one as 16-bit.
 """
 
 import contextlib
@@ -34,10 +44,10 @@ import numpy as np
 
 from ...spec.pure_colours import PALETTE_SIZE
 from ...tiling import DEFAULT_TILES
-from ..base import Capabilities, RecoveryMaps
-from .blocks import BLOCK_SIDE, active_blocks
+from ..base import Capabilities, ReadyResult, RecoveryMaps
+from .classify import BlockClassifier, BlockLists, block_grid
 from .context import REQUIRED_VERSION, GLUnavailable, create_context
-from .glsl import load_source
+from .paths import ComputePath, FragmentPath, available_paths, choose_path, software_renderer
 
 __all__ = ["GLBackend", "GLUnavailable", "EngineTexture"]
 
@@ -46,11 +56,17 @@ __all__ = ["GLBackend", "GLUnavailable", "EngineTexture"]
 EngineTexture = namedtuple("EngineTexture", "texture channel linear")
 
 _CONVERT_NONE, _CONVERT_DECODE, _CONVERT_ENCODE = 0, 1, 2
-_UNITS = {"original_image": 0, "filtered_image": 1, "model_map": 2, "previous_iterate": 3, "recovered_work": 3,
-          "original_work": 4, "filtered_work": 5, "transfer_table": 6, "fixed_a_map": 7, "fixed_b_map": 8}
 # Where each map lives: (texture key, channel).
 _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("model", 3),
                  "edge_strength": ("edge", 0)}
+# The textures made when first needed: (components, dtype); "result" has F's.
+_WORK_TEXTURES = {"original_work": (4, "f4"), "filtered_work": (4, "f4"), "model": (4, "f4"), "edge": (1, "f4"),
+                  "fixed_a": (4, "f4"), "fixed_b": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4")}
+_RESULT_BITS = {np.dtype(np.uint8): 8, np.dtype(np.uint16): 16}
+
+#: How a texture of 1 to 4 channels reads as straight RGBA: the texture unit expands grey
+#: and RGB for free, where a CPU expansion to RGBA cost more than the upload itself.
+_SWIZZLES = {1: "RRR1", 2: "RRRG", 3: "RGB1", 4: "RGBA"}
 
 
 def _texture_dtype(dtype):
@@ -59,17 +75,6 @@ def _texture_dtype(dtype):
     if dtype == np.uint16:
         return "nu2"
     return "f4"
-
-
-#: How a texture of 1 to 4 channels reads as straight RGBA: the texture unit expands grey
-#: and RGB for free, where a CPU expansion to RGBA cost more than the upload itself.
-_SWIZZLES = {1: "RRR1", 2: "RRRG", 3: "RGB1", 4: "RGBA"}
-# Above this share of active blocks one full-screen triangle is cheaper than the blocks.
-_FULL_SCREEN_SHARE = 0.9
-
-def _pixels(image, layout, dtype):
-    """The image's pixels as a contiguous array of the texture's dtype (floats as float32)."""
-    return np.ascontiguousarray(image.reshape(layout.height, layout.width, layout.channels), dtype=dtype)
 
 
 def _current(method):
@@ -88,12 +93,42 @@ def _current(method):
     return wrapper
 
 
+@contextlib.contextmanager
+def _driver_memory(what):
+    """Out of memory shows in the driver as a texture or framebuffer it cannot make ("the
+    framebuffer is not complete" on llvmpipe, measured under prlimit): a MemoryError, which
+    the pipeline turns into its one-line figures. Textures and framebuffers are made when a
+    pass first needs them, so this guards each making, not only the upload's."""
+    try:
+        yield
+    except moderngl.Error as error:
+        raise MemoryError(f"the GL driver could not make {what}: {error}") from None
+
+
+class _PendingReadback:
+    """A result on its way into a pixel buffer; :meth:`wait` copies it out when it is there."""
+
+    def __init__(self, backend, buffer, array):
+        self._backend, self._buffer, self._array = backend, buffer, array
+
+    def wait(self):
+        return self._backend._finish_readback(self._buffer, self._array)
+
+
 class GLBackend:
-    """The passes as GLSL 3.30 fragment shaders in one moderngl context (made or borrowed)."""
+    """The passes as GLSL shaders in one moderngl context (made or borrowed).
+
+    Parameters
+    ----------
+    context : moderngl.Context, optional
+        A context to borrow; by default a standalone one is made.
+    gl_path : {"auto", "fragment", "compute"}
+        How the passes run (``paths.choose_path``).
+    """
 
     name = "gl"
 
-    def __init__(self, context=None):
+    def __init__(self, context=None, gl_path="auto"):
         if context is None:
             self.context = create_context()
             self._owns_context = True
@@ -103,43 +138,79 @@ class GLBackend:
                                     f"aarecovery needs {REQUIRED_VERSION} or later")
             self.context = context
             self._owns_context = False
+        try:
+            path = choose_path(self.context, gl_path)
+        except Exception:
+            self.release()
+            raise
         max_tile = int(self.context.info["GL_MAX_TEXTURE_SIZE"])
-        self.capabilities = Capabilities(max_tile=max_tile, default_tile=min(DEFAULT_TILES["gl"], max_tile))
-        self._programs = {}
-        self._textures = {}
+        default_tile = DEFAULT_TILES["gl-software" if software_renderer(self.context) else "gl"]
+        self.capabilities = Capabilities(max_tile=max_tile, default_tile=min(default_tile, max_tile),
+                                         gl_paths=available_paths(self.context), gl_path=path)
         self._framebuffers = {}
+        self._path = (ComputePath if path == "compute" else FragmentPath)(self.context, self._framebuffer)
+        #: Whether the compute path's fit keeps its neighbourhoods in shared memory: off, as
+        #: no device measured faster with it (``paths.py``); ``aarecovery bench`` times both.
+        self.shared_tile = False
+        #: None, or a callable that ``aarecovery bench`` gives to time the stages: called with
+        #: "upload", "classify" or "passes" once the work of that stage is finished.
+        self.stage_clock = None
+        self._classifier = BlockClassifier(self.context, compute="compute" in self.capabilities.gl_paths,
+                                           runs=path == "fragment")
+        self._textures = {}
+        self._pixel_buffers = {}
         self._key = None
-        self._readback = None
+        self._lists = {}
+        self._staging = {}
+        self._readbacks = []
+        self._next_readback = 0
+        # A GPU copies a result into a pixel buffer while it computes the next tile; a
+        # software renderer would only add a copy (llvmpipe computes on the CPU anyway).
+        self._overlap_readback = not software_renderer(self.context)
         self._ran = None
-        self._blocks = {}
-        self._block_arrays = {}
-
-    # -- programs ---------------------------------------------------------------------------
-    def _program(self, fragment, vertex="fullscreen.vert", **defines):
-        defines = {**self._defines, **defines}
-        key = (fragment, vertex, tuple(sorted(defines.items())))
-        if key not in self._programs:
-            program = self.context.program(vertex_shader=load_source(vertex),
-                                           fragment_shader=load_source(fragment, defines))
-            for uniform, unit in _UNITS.items():
-                if uniform in program:
-                    program[uniform] = unit
-            vertex_array = self.context.vertex_array(program, []) if vertex == "fullscreen.vert" else None
-            self._programs[key] = (program, vertex_array)
-        return self._programs[key]
 
     # -- images -----------------------------------------------------------------------------
     @_current
     def load(self, original, o_layout, filtered, f_layout, linear_input, blend_space):
+        o_dtype, f_dtype = self._configure(o_layout, f_layout, linear_input, blend_space)
+        size = (f_layout.width, f_layout.height)
+        key = (size, o_dtype, o_layout.channels, f_dtype, f_layout.channels)
+        if key != self._key:
+            self._allocate(size, o_dtype, o_layout.channels, f_dtype, f_layout.channels)
+            self._key = key
+        self._upload("original", original, o_layout, o_dtype)
+        self._upload("filtered", filtered, f_layout, f_dtype)
+        self._stage("upload")
+        self._classified = set()
+        self._working_lists = set()
+        self._ran = None
+        # F's blocks now, while its upload is fresh; O's are needed only with pure colours.
+        self._block_lists("filtered")
+        self._stage("classify")
+
+    def _configure(self, o_layout, f_layout, linear_input, blend_space):
+        """The shader defines and formats for a pair; returns the textures' dtypes for O and F."""
         if blend_space == "linear" and not linear_input:
             input_mode, output_mode = _CONVERT_DECODE, _CONVERT_ENCODE
         elif blend_space == "srgb" and linear_input:
             input_mode, output_mode = _CONVERT_ENCODE, _CONVERT_DECODE
         else:
             input_mode = output_mode = _CONVERT_NONE
+        # The result texture has F's format where the path can write it (compute shaders store
+        # no 3-channel formats, and 16-bit RGB need not be renderable): it then starts as a
+        # copy of F, and the readback needs no conversion.
+        bits = _RESULT_BITS.get(np.dtype(f_layout.dtype))
+        self._result_is_filtered_format = bits is not None and (
+            f_layout.channels != 3 or (bits == 8 and self._path.name == "fragment"))
+        result_channels = f_layout.channels if self._result_is_filtered_format else 4
         self._defines = {"INPUT_CONVERT": input_mode, "OUTPUT_CONVERT": output_mode,
                          "EXACT_UNTOUCHED": int(f_layout.dtype != np.uint8),
-                         "WORK_IS_LINEAR": int(blend_space == "linear")}
+                         "WORK_IS_LINEAR": int(blend_space == "linear"), "RESULT_CHANNELS": result_channels,
+                         # The result texture's image format, for the compute path's imageStore.
+                         "RESULT_FORMAT": ("r", "rg", "rgb", "rgba")[result_channels - 1] + (str(bits) if bits else "32f")}
+        # Straight from the result texture into the caller's layout where it holds F's
+        # channels in order (grey+alpha in RGBA does not).
+        self._readback_channels = 4 if result_channels == 4 and f_layout.channels == 2 else f_layout.channels
         self._blend_space = blend_space
         self._linear = dict.fromkeys(("original", "filtered", "result"), linear_input)
 
@@ -147,64 +218,47 @@ class GLBackend:
             return layout.dtype if layout.dtype in (np.uint8, np.uint16) else np.dtype(np.float32)
 
         o_dtype, f_dtype = texture_dtype(o_layout), texture_dtype(f_layout)
-        size = (f_layout.width, f_layout.height)
-        key = (size, o_dtype, o_layout.channels, f_dtype, f_layout.channels)
-        if key != self._key:
-            self._allocate(size, o_dtype, o_layout.channels, f_dtype, f_layout.channels)
-            self._key = key
-        t = self._textures
-        original_pixels = _pixels(original, o_layout, o_dtype)
-        filtered_pixels = _pixels(filtered, f_layout, f_dtype)
-        t["original"].write(original_pixels)
-        t["filtered"].write(filtered_pixels)
-        # O's blocks are needed only with pure colours: found when first asked for.
-        self._original_pixels = original_pixels
-        self._set_blocks({"filtered": active_blocks(filtered_pixels)}, size)
-        self._model_blocks = "stale"
-        with self._passes():
-            self._draw(self._framebuffers["working"], "to_working_space.frag",
-                       {"original_image": t["original"], "filtered_image": t["filtered"]})
-        self._ran = None
+        # Opaque integer inputs already in the working space's encoding are their own working
+        # space: a texel reads as value / (2^n - 1), exactly what to_working_space stores.
+        # Float inputs are not: the pass clamps them to [0, 1].
+        self._uploads_are_working = (input_mode == _CONVERT_NONE and o_dtype != np.float32 and f_dtype != np.float32
+                                     and not o_layout.alpha and not f_layout.alpha)
+        return o_dtype, f_dtype
 
-    def _prepare_blocks(self, name):
-        """Make sure block set `name` exists, and that outside it the model reads as unfitted.
+    def _stage(self, name):
+        if self.stage_clock is not None:
+            self.context.finish()
+            self.stage_clock(name)
 
-        The block passes write the model, the iterates and the edge map only inside their
-        blocks; the final full-image pass reads the model everywhere (beta 0 must mean R = F
-        there), and the edge map is read back everywhere. Iterates outside the blocks are
-        never read (see :func:`active_blocks`).
-        """
-        if name not in self._blocks:
-            self._set_blocks({name: active_blocks(self._original_pixels)}, self._key[0], keep=True)
-        count = self._blocks[name][0]
-        if count is not None and self._model_blocks != name:
-            self._framebuffers["model"].clear(0.5, 0.0, 0.0, 0.0)
-            self._framebuffers["edge"].clear(0.0, 0.0, 0.0, 0.0)
-        self._model_blocks = name if count is not None else None
+    def _upload(self, name, image, layout, dtype):
+        pixels = image.reshape(layout.height, layout.width, layout.channels)
+        if pixels.dtype != dtype or not pixels.flags.c_contiguous:
+            # A tile is a strided view of the image: gathered into a buffer kept for the
+            # next tile, without a fresh allocation's page faults.
+            staging = self._staging.get(name)
+            if staging is None or staging.shape != pixels.shape or staging.dtype != dtype:
+                staging = self._staging[name] = np.empty(pixels.shape, dtype)
+            np.copyto(staging, pixels, casting="same_kind")
+            pixels = staging
+        self._textures[name].write(pixels)
 
-    def _set_blocks(self, block_sets, size, keep=False):
-        """Keep instance buffers of active blocks: ``{name: (count, buffer)}``, where a count of
-        None means "draw the whole image" (almost every block is active). With `keep`, add
-        to the sets already made for this pair instead of replacing them."""
-        if not keep:
-            for vertex_array in self._block_arrays.values():
-                vertex_array.release()
-            self._block_arrays = {}
-            for _, buffer in self._blocks.values():
-                if buffer is not None:
-                    buffer.release()
-            self._blocks = {}
-        total = -(-size[0] // BLOCK_SIDE) * -(-size[1] // BLOCK_SIDE)
-        for name, blocks in block_sets.items():
-            if name in self._blocks:
-                continue
-            if len(blocks) > _FULL_SCREEN_SHARE * total:
-                self._blocks[name] = (None, None)
-            else:
-                self._blocks[name] = (len(blocks), self.context.buffer(blocks.tobytes()) if len(blocks) else None)
+    def _block_lists(self, name):
+        """The block lists of the uploaded O or F (`name`), classified on the GPU when first asked for."""
+        grid = block_grid(self._key[0])
+        lists = self._lists.get(name)
+        if lists is None or lists.grid != grid:
+            if lists is not None:
+                self._path.forget_blocks(lists)
+                lists.release()
+            lists = self._lists[name] = BlockLists(self.context, grid)
+        if name not in self._classified:
+            self._classifier.classify(self._textures[name], lists)
+            self._classified.add(name)
+        return lists
 
     def _texture(self, size, components, dtype):
-        texture = self.context.texture(size, components, dtype=dtype, alignment=1)
+        with _driver_memory(f"a {size[0]}x{size[1]} texture"):
+            texture = self.context.texture(size, components, dtype=dtype, alignment=1)
         texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
         texture.repeat_x = texture.repeat_y = False
         return texture
@@ -213,11 +267,9 @@ class GLBackend:
         self._release_images()
         try:
             self._allocate_images(size, o_dtype, o_channels, f_dtype, f_channels)
-        except moderngl.Error as error:
-            # Out of memory shows in the driver as a texture or framebuffer it cannot make
-            # ("the framebuffer is not complete" on llvmpipe, measured under prlimit).
+        except MemoryError:
             self._release_images()
-            raise MemoryError(f"the GL driver could not make the {size[0]}x{size[1]} textures: {error}") from None
+            raise
 
     def _allocate_images(self, size, o_dtype, o_channels, f_dtype, f_channels):
         t = self._textures
@@ -225,30 +277,31 @@ class GLBackend:
         t["original"].swizzle = _SWIZZLES[o_channels]
         t["filtered"] = self._texture(size, f_channels, _texture_dtype(f_dtype))
         t["filtered"].swizzle = _SWIZZLES[f_channels]
-        t["original_work"] = self._texture(size, 4, "f4")
-        t["filtered_work"] = self._texture(size, 4, "f4")
-        t["model"] = self._texture(size, 4, "f4")
-        t["edge"] = self._texture(size, 1, "f4")
-        t["fixed_a"] = self._texture(size, 4, "f4")
-        t["fixed_b"] = self._texture(size, 4, "f4")
-        t["transfer_table"] = self._texture((256, 1), 3, "f4")
-        t["iterate_a"] = self._texture(size, 4, "f4")
-        t["iterate_b"] = self._texture(size, 4, "f4")
-        t["result"] = self._texture(size, 4, _texture_dtype(f_dtype))
-        fb = self._framebuffers
-        fb["working"] = self.context.framebuffer([t["original_work"], t["filtered_work"]])
-        fb["filtered_work"] = self.context.framebuffer([t["filtered_work"]])
-        fb["model"] = self.context.framebuffer([t["model"]])
-        fb["edge"] = self.context.framebuffer([t["edge"]])
-        fb["fit"] = self.context.framebuffer([t["model"], t["iterate_a"]])
-        fb["fit_maps"] = self.context.framebuffer([t["model"], t["iterate_a"], t["edge"]])
-        fb["fit_pure"] = self.context.framebuffer([t["model"], t["iterate_a"], t["fixed_a"], t["fixed_b"]])
-        fb["fit_pure_maps"] = self.context.framebuffer([t["model"], t["iterate_a"], t["edge"], t["fixed_a"],
-                                                        t["fixed_b"]])
-        fb["iterate_a"] = self.context.framebuffer([t["iterate_a"]])
-        fb["iterate_b"] = self.context.framebuffer([t["iterate_b"]])
-        fb["result"] = self.context.framebuffer([t["result"]])
-        self._readback = np.empty((size[1], size[0], 4), np.dtype(f_dtype))
+        result_channels = self._defines["RESULT_CHANNELS"]
+        t["result"] = self._texture(size, result_channels, _texture_dtype(f_dtype))
+        t["result"].swizzle = _SWIZZLES[result_channels]
+        # Two, so that a tile's result can be read while the next one's is started; flat, as
+        # each tile reads the part it decides.
+        self._readbacks = [np.empty(size[0] * size[1] * 4, np.dtype(f_dtype)) for _ in range(2)]
+
+    def _work(self, name):
+        """A working texture of the loaded size, made when first needed and kept."""
+        if name not in self._textures:
+            components, dtype = _WORK_TEXTURES[name]
+            self._textures[name] = self._texture(self._key[0], components, dtype)
+        return self._textures[name]
+
+    def _working_textures(self):
+        if self._uploads_are_working:
+            return self._textures["original"], self._textures["filtered"]
+        return self._work("original_work"), self._work("filtered_work")
+
+    def _framebuffer(self, textures):
+        key = tuple(id(texture) for texture in textures)
+        if key not in self._framebuffers:
+            with _driver_memory("a framebuffer"):
+                self._framebuffers[key] = self.context.framebuffer(list(textures))
+        return self._framebuffers[key]
 
     # -- passes -----------------------------------------------------------------------------
     @contextlib.contextmanager
@@ -257,34 +310,21 @@ class GLBackend:
         enable flags as they were afterwards."""
         previous = None if self._owns_context else self.context.fbo
         try:
-            with self.context.scope(self._framebuffers["working"], enable_only=moderngl.NOTHING):
+            with self.context.scope(self._framebuffer([self._textures["result"]]), enable_only=moderngl.NOTHING):
                 yield
         finally:
             if previous is not None:
                 previous.use()
 
-    def _draw(self, framebuffer, fragment, inputs, uniforms=None, blocks=None, **defines):
-        """One pass: over the whole image, or over the active blocks of the set `blocks` names."""
-        count, buffer = self._blocks.get(blocks, (None, None))
-        program, vertex_array = self._program(fragment, "fullscreen.vert" if count is None else "blocks.vert",
-                                              **defines)
-        for name, value in (uniforms or {}).items():
-            if name in program:
-                program[name] = value
-        for uniform, texture in inputs.items():
-            texture.use(_UNITS[uniform])
-        framebuffer.use()
-        if count is None:
-            vertex_array.render(moderngl.TRIANGLES, vertices=3)
+    def _to_working_space(self, lists=None, list_name=None):
+        """O and F into the working textures, over a block list or (`lists` None) everywhere."""
+        original_work, filtered_work = self._working_textures()
+        if self._uploads_are_working:
             return
-        if count == 0:
-            return
-        program["image_size"] = self._key[0]
-        program["block_side"] = BLOCK_SIDE
-        key = (id(program), blocks)
-        if key not in self._block_arrays:
-            self._block_arrays[key] = self.context.vertex_array(program, [(buffer, "2i/i", "block")])
-        self._block_arrays[key].render(moderngl.TRIANGLES, vertices=6, instances=count)
+        self._path.run_pass("to_working_space", {"original_image": self._textures["original"],
+                                                 "filtered_image": self._textures["filtered"]},
+                            [original_work, filtered_work], blocks=lists, list_name=list_name,
+                            defines=self._defines)
 
     @_current
     def run(self, plan, maps):
@@ -292,27 +332,48 @@ class GLBackend:
         # Pure colours restore thin features that the filter erased, where F is flat but O is
         # not: their passes cover O's active blocks, not F's.
         active = "filtered" if prior is None else "original"
-        self._prepare_blocks(active)
-        sources = {"original_work": self._textures["original_work"],
-                   "filtered_work": self._textures["filtered_work"], "filtered_image": self._textures["filtered"]}
+        lists = self._block_lists(active)
+        self._stage("classify")
+        original_work, filtered_work = self._working_textures()
+        sources = {"original_work": original_work, "filtered_work": filtered_work,
+                   "filtered_image": self._textures["filtered"]}
         uniforms = {"sigma_d": plan.sigma_d, "sigma_e": plan.sigma_e, "strength": plan.strength}
         if prior is not None:
-            sources["transfer_table"] = self._textures["transfer_table"]
+            sources["transfer_table"] = self._transfer_table(prior)
             uniforms.update(self._pure_colour_uniforms(prior))
-        defines = {"PURE_COLOURS": int(prior is not None)}
+        defines = {**self._defines, "PURE_COLOURS": int(prior is not None)}
         with self._passes():
+            if active not in self._working_lists:
+                self._to_working_space(lists, "dilated")
+                self._working_lists.add(active)
             if plan.iterations > 0 or maps:
-                self._fit_blend_model(sources, uniforms, defines, active, maps)
-            if plan.iterations == 0:
-                self._draw(self._framebuffers["result"], "from_working_space.frag", sources, FROM_FILTERED=1)
+                self._fit_blend_model(sources, uniforms, defines, lists, maps)
+            result = self._textures["result"]
+            keep = {"filtered_image": self._textures["filtered"]}
+            if self._result_is_filtered_format:
+                # A copy (a memcpy on llvmpipe: 10 ms against 110 ms for keep_filtered over
+                # the inactive 85% of a 4096 x 4096 threshold pair, CPU time).
+                self.context.copy_framebuffer(self._framebuffer([result]),
+                                              self._framebuffer([self._textures["filtered"]]))
+            elif plan.iterations == 0:
+                self._path.run_pass("keep_filtered", keep, [result], defines=defines)
             else:
-                self._jacobi_steps(sources, defines, active, plan.iterations)
+                self._path.run_pass("keep_filtered", keep, [result], blocks=lists, list_name="inactive",
+                                    defines=defines)
+            if plan.iterations > 0:
+                self._jacobi_steps(sources, defines, lists, plan.iterations)
+        self._stage("passes")
         self._ran = {"maps": maps}
 
-    def _pure_colour_uniforms(self, prior):
-        """The filter's table (3 KB, into its texture) and the palette as uniforms: per run,
-        as they belong to the plan, not to the loaded pair."""
+    def _transfer_table(self, prior):
+        """The filter's table (3 KB): per run, as it belongs to the plan, not to the loaded pair."""
+        if "transfer_table" not in self._textures:
+            self._textures["transfer_table"] = self._texture((256, 1), 3, "f4")
         self._textures["transfer_table"].write(np.ascontiguousarray(prior.table, np.float32))
+        return self._textures["transfer_table"]
+
+    def _pure_colour_uniforms(self, prior):
+        """The palette and the table's keys as uniforms."""
         palette = np.zeros((PALETTE_SIZE, 3), np.float32)
         colours = prior.palette_in(self._blend_space)
         palette[:len(colours)] = colours
@@ -322,30 +383,41 @@ class GLBackend:
                     key_low=tuple(map(float, low)), key_high=tuple(map(float, high)),
                     clamp_ends=int(prior.key_low is not None), to_cube=int(prior.to_cube))
 
-    def _fit_blend_model(self, sources, uniforms, defines, active, maps):
+    def _fit_blend_model(self, sources, uniforms, defines, lists, maps):
         """The model and the first Jacobi iterate (and the edge map, the fixed pure colours)."""
         pure = defines["PURE_COLOURS"]
-        framebuffer = ("fit_pure" if pure else "fit") + ("_maps" if maps else "")
-        outputs = dict(FIXED_LOCATION=2 + int(maps), FIXED_LOCATION_B=3 + int(maps)) if pure else {}
-        self._draw(self._framebuffers[framebuffer], "fit_blend_model.frag", sources, uniforms, blocks=active,
-                   MAPS=int(maps), **outputs, **defines)
+        outputs = [self._work("model"), self._work("iterate_a")]
+        if maps:
+            # Maps are read everywhere; outside the active blocks they show the unfitted model.
+            outputs.append(self._work("edge"))
+            self._framebuffer([outputs[0]]).clear(0.5, 0.0, 0.0, 0.0)
+            self._framebuffer([outputs[2]]).clear(0.0, 0.0, 0.0, 0.0)
+        locations = {}
+        if pure:
+            outputs += [self._work("fixed_a"), self._work("fixed_b")]
+            locations = dict(FIXED_LOCATION=2 + int(maps), FIXED_LOCATION_B=3 + int(maps))
+        self._path.run_pass("fit_blend_model", sources, outputs, blocks=lists, list_name="active", uniforms=uniforms,
+                            defines={**defines, "MAPS": int(maps), "SHARED_TILE": int(self.shared_tile), **locations})
 
-    def _jacobi_steps(self, sources, defines, active, iterations):
+    def _jacobi_steps(self, sources, defines, lists, iterations):
         """Iterations 2..n ping-pong between two textures; the last writes the result.
 
         R1 from R0 = F is the fit's first iterate; with one iteration the last pass forms it
-        again, reading F itself, since outside the blocks no iterate is written.
+        again, reading F itself. Every value a step gathers lies in an active block (the
+        margin of ``blocks.active_mask``), where the step before wrote it.
         """
-        t = self._textures
-        inputs = {**sources, "model_map": t["model"]}
+        inputs = {**sources, "model_map": self._work("model")}
         if defines["PURE_COLOURS"]:
-            inputs.update(fixed_a_map=t["fixed_a"], fixed_b_map=t["fixed_b"])
-        previous = "iterate_a" if iterations > 1 else "filtered_work"
+            inputs.update(fixed_a_map=self._work("fixed_a"), fixed_b_map=self._work("fixed_b"))
+        previous = self._work("iterate_a") if iterations > 1 else sources["filtered_work"]
         for step in range(2 if iterations > 1 else 1, iterations + 1):
             final = step == iterations
-            target = "result" if final else ("iterate_b" if previous == "iterate_a" else "iterate_a")
-            self._draw(self._framebuffers[target], "jacobi_step.frag", {**inputs, "previous_iterate": t[previous]},
-                       blocks=None if final else active, FINAL=int(final), **defines)
+            if final:
+                target = self._textures["result"]
+            else:
+                target = self._work("iterate_b" if previous is self._textures.get("iterate_a") else "iterate_a")
+            self._path.run_pass("jacobi_step", {**inputs, "previous_iterate": previous}, [target], blocks=lists,
+                                list_name="active", defines={**defines, "FINAL": int(final)})
             previous = target
 
     @_current
@@ -354,9 +426,31 @@ class GLBackend:
 
     # -- results ----------------------------------------------------------------------------
     @_current
-    def read_result(self):
-        self._textures["result"].read_into(self._readback)
-        return self._readback
+    def start_readback(self, window=None):
+        rows, columns = window or (slice(0, self._key[0][1]), slice(0, self._key[0][0]))
+        height, width = rows.stop - rows.start, columns.stop - columns.start
+        slot = self._next_readback
+        self._next_readback = 1 - slot
+        array = self._readbacks[slot][:height * width * self._readback_channels].reshape(
+            height, width, self._readback_channels)
+        source = self._framebuffer([self._textures["result"]])
+        read = dict(viewport=(columns.start, rows.start, width, height), components=self._readback_channels,
+                    dtype=_texture_dtype(array.dtype))
+        if not self._overlap_readback:
+            source.read_into(array, **read)
+            return ReadyResult(array)
+        name = f"readback_{slot}"
+        if name not in self._pixel_buffers or self._pixel_buffers[name].size < array.nbytes:
+            if name in self._pixel_buffers:
+                self._pixel_buffers[name].release()
+            self._pixel_buffers[name] = self.context.buffer(reserve=self._readbacks[slot].nbytes, dynamic=True)
+        source.read_into(self._pixel_buffers[name], **read)
+        return _PendingReadback(self, self._pixel_buffers[name], array)
+
+    @_current
+    def _finish_readback(self, buffer, array):
+        buffer.read_into(array, size=array.nbytes)
+        return array
 
     @_current
     def read_maps(self):
@@ -387,21 +481,24 @@ class GLBackend:
             framebuffer.release()
         for texture in self._textures.values():
             texture.release()
-        self._framebuffers, self._textures = {}, {}
+        for buffer in self._pixel_buffers.values():
+            buffer.release()
+        self._framebuffers, self._textures, self._pixel_buffers = {}, {}, {}
+        self._staging = {}
         self._key = None
 
     def release(self):
-        self._release_objects()
+        if hasattr(self, "_path"):
+            self._release_objects()
         if self._owns_context:
             self.context.release()
             self._owns_context = False
 
     @_current
     def _release_objects(self):
-        self._set_blocks({}, (1, 1))
+        self._path.release()
+        for lists in self._lists.values():
+            lists.release()
+        self._lists = {}
+        self._classifier.release()
         self._release_images()
-        for program, vertex_array in self._programs.values():
-            if vertex_array is not None:
-                vertex_array.release()
-            program.release()
-        self._programs = {}

@@ -2,18 +2,32 @@
 
 Where O or F is flat around a pixel, its edge strength is exactly 0, beta is 0 and R = F;
 llvmpipe shades every fragment a triangle covers (both sides of a branch), so skipping must
-happen before the fragment shader, by drawing only the active blocks (``blocks.vert``).
+happen before the fragment shader, by drawing only the active blocks (``blocks.vert``), and
+a GPU's compute path dispatches one work group per active block (``compute.glsl``).
+
+The backend classifies blocks on the GPU (``classify.py``); the functions here are the
+specification it is tested against, and the CPU half of the GL 3.3 classification, which
+turns a block mask made on the GPU into lists.
 """
 
 import numpy as np
 
-__all__ = ["BLOCK_SIDE", "active_blocks"]
+__all__ = ["BLOCK_SIDE", "MARGIN", "LISTS", "DRAW_COMMAND_WORDS", "DISPATCH_COMMAND_WORDS", "active_mask",
+           "active_blocks", "block_lists", "expand_runs"]
 
 BLOCK_SIDE = 16
+#: Pixels around a block whose differences still wake it (see :func:`active_mask`).
+MARGIN = 2
+#: The lists one classification makes, in the order of ``block_lists.glsl``: the active
+#: blocks; those and the 8 around each (what the active blocks read: the working space is
+#: made there); and the rest, where R = F.
+LISTS = ("active", "dilated", "inactive")
+#: Words of one indirect draw command (moderngl's stride) and one dispatch command.
+DRAW_COMMAND_WORDS, DISPATCH_COMMAND_WORDS = 5, 3
 
 
-def active_blocks(pixels, side=BLOCK_SIDE, margin=2):
-    """Blocks of `side` x `side` pixels whose surroundings are not flat.
+def active_mask(pixels, side=BLOCK_SIDE, margin=MARGIN):
+    """Which blocks of `side` x `side` pixels have surroundings that are not flat.
 
     A block is active when a pixel that differs from a neighbour lies in it or within
     `margin` pixels of it. With a margin of 2, every pixel whose 3x3 window is not flat
@@ -29,8 +43,7 @@ def active_blocks(pixels, side=BLOCK_SIDE, margin=2):
 
     Returns
     -------
-    ndarray of int32, shape (N, 2)
-        ``(column, row)`` block indices, row-major.
+    ndarray of bool, shape (ceil(H / side), ceil(W / side))
     """
     height, width, channels = pixels.shape
     # Rows of interleaved values, compared C values apart: contiguous work, no per-channel
@@ -60,5 +73,61 @@ def active_blocks(pixels, side=BLOCK_SIDE, margin=2):
         hit = corner.any(axis=(1, 3))
         active[max(0, dy):rows + min(0, dy), max(0, dx):columns + min(0, dx)] |= \
             hit[max(0, -dy):rows - max(0, dy), max(0, -dx):columns - max(0, dx)]
-    found = np.argwhere(active)
-    return np.ascontiguousarray(found[:, ::-1], dtype=np.int32)
+    return active
+
+
+def _as_list(mask):
+    """``(column, row)`` indices of the true blocks, row-major, as the GPU lists hold them."""
+    return np.ascontiguousarray(np.argwhere(mask)[:, ::-1], dtype=np.int32)
+
+
+def active_blocks(pixels, side=BLOCK_SIDE, margin=MARGIN):
+    """The active blocks of :func:`active_mask` as a list.
+
+    Returns
+    -------
+    ndarray of int32, shape (N, 2)
+        ``(column, row)`` block indices, row-major.
+    """
+    return _as_list(active_mask(pixels, side, margin))
+
+
+def _as_runs(mask):
+    """Runs of true blocks along rows, ``(column | (length - 1) << 16, row)``, row-major."""
+    edges = np.diff(np.pad(mask, ((0, 0), (1, 1))).astype(np.int8), axis=1)
+    starts, stops = np.argwhere(edges == 1), np.argwhere(edges == -1)  # pairs, in the same order
+    runs = np.stack([starts[:, 1] | ((stops[:, 1] - starts[:, 1] - 1) << 16), starts[:, 0]], axis=-1)
+    return np.ascontiguousarray(runs, dtype=np.int32)
+
+
+def expand_runs(entries):
+    """The blocks of run entries (see :func:`block_lists`), as ``(column, row)`` pairs."""
+    blocks = [(column & 0xFFFF) + offset for column, _ in entries for offset in range((column >> 16) + 1)]
+    rows = [row for column, row in entries for _ in range((column >> 16) + 1)]
+    return np.asarray(list(zip(blocks, rows)), dtype=np.int32).reshape(-1, 2)
+
+
+def block_lists(mask, runs=False):
+    """The three lists of :data:`LISTS` from a block mask.
+
+    Parameters
+    ----------
+    mask : ndarray of bool, shape (rows, columns)
+        Active blocks (:func:`active_mask`, or the GPU's block mask).
+    runs : bool
+        List runs of blocks along rows, as the fragment path draws them: one entry
+        ``(column | (length - 1) << 16, row)`` per run.
+
+    Returns
+    -------
+    dict of str to ndarray of int32, shape (N, 2)
+        ``(column, row)`` block indices (or runs) per list, row-major.
+    """
+    padded = np.pad(mask, 1)
+    rows, columns = mask.shape
+    dilated = np.zeros_like(mask)
+    for dy in range(3):
+        for dx in range(3):
+            dilated |= padded[dy:dy + rows, dx:dx + columns]
+    listed = _as_runs if runs else _as_list
+    return {"active": listed(mask), "dilated": listed(dilated), "inactive": listed(~mask)}

@@ -34,8 +34,9 @@ def load_source(name, defines=None):
     ----------
     name : str
         File name under ``aarecovery/backends/gl/shaders``.
-    defines : dict of str to int, optional
-        ``#define KEY VALUE`` lines placed right after ``#version``.
+    defines : dict of str to int or str, optional
+        ``#define KEY VALUE`` lines placed right after ``#version`` (a str value is a word,
+        such as an image format).
 
     Returns
     -------
@@ -67,6 +68,7 @@ def load_source(name, defines=None):
     lines = text.split("\n")
     if not lines[0].startswith("#version"):
         raise ShaderSourceError(f"shader {name!r} must start with #version")
-    header = [f"#define {key} {int(value)}" for key, value in sorted((defines or {}).items())]
+    header = [f"#define {key} {value if isinstance(value, str) else int(value)}"
+              for key, value in sorted((defines or {}).items())]
     legend = "// source numbers: " + ", ".join(f"{i}={f}" for i, f in enumerate(files))
     return "\n".join([lines[0], legend] + header + ["#line 2 0"] + lines[1:]) + "\n"

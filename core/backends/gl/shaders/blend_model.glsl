@@ -11,7 +11,7 @@ const float TINY = 1e-12;
 const float FAINT = 1e-30;
 
 struct BlendFit {
-    vec4 model;           // alpha, beta, 9 * index_a + index_b (+ 81, 162: pure colours), residual
+    vec4 model;           // alpha, beta, the extremes' offsets (+ 81, 162: pure colours), residual
     vec4 first_iterate;   // working space
     float edge;           // edge strength e_p
     vec4 fixed_a;         // f of the pure colour at extreme a, where the code says so
@@ -63,20 +63,20 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
     // is never used; skipping the fit there is what makes thresholded and posterized
     // images (mostly flat) fast.
     vec4 f[9];
-    for (int i = 0; i < 9; ++i) f[i] = texelFetch(filtered_work, clamp_to_image(p + OFFSETS[i], size), 0);
+    for (int i = 0; i < 9; ++i) f[i] = filtered_neighbour(p, i, size);
     float filtered_gradient = sobel_magnitude(f);
     vec4 c[9];
     float edge = 0.0;
 #if PURE_COLOURS
     // With pure colours, a thin feature that the filter erased leaves F flat where it must
     // be restored: only a flat O means there is nothing to fit (see fit_pure_colour_model).
-    for (int i = 0; i < 9; ++i) c[i] = texelFetch(original_work, clamp_to_image(p + OFFSETS[i], size), 0);
+    for (int i = 0; i < 9; ++i) c[i] = original_neighbour(p, i, size);
     float original_gradient = sobel_magnitude(c);
     edge = original_gradient * filtered_gradient;
     if (original_gradient == 0.0) {
 #else
     if (filtered_gradient > 0.0) {
-        for (int i = 0; i < 9; ++i) c[i] = texelFetch(original_work, clamp_to_image(p + OFFSETS[i], size), 0);
+        for (int i = 0; i < 9; ++i) c[i] = original_neighbour(p, i, size);
         edge = sobel_magnitude(c) * filtered_gradient;
     }
     if (edge == 0.0) {
@@ -100,12 +100,13 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
     float t_max = 0.0;
     float t_min = 0.0;
     vec4 c_a = c[0], c_b = c[0], f_a = f[0], f_b = f[0];
+    ivec2 offset_a = ivec2(0), offset_b = ivec2(0);
     for (int i = 1; i < 9; ++i) {
         vec4 offset = c[i] - c[0];
         float t = dot(offset, x);
         if (dot(offset, offset) - t * t < reach_sq) {
-            if (t > t_max) { t_max = t; a = i; c_a = c[i]; f_a = f[i]; }
-            if (t < t_min) { t_min = t; b = i; c_b = c[i]; f_b = f[i]; }
+            if (t > t_max) { t_max = t; a = i; c_a = c[i]; f_a = f[i]; offset_a = OFFSETS[i]; }
+            if (t < t_min) { t_min = t; b = i; c_b = c[i]; f_b = f[i]; offset_b = OFFSETS[i]; }
         }
     }
     // The direction's sign is arbitrary: name the extremes in neighbour order (see the twin).
@@ -113,16 +114,18 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
         int first = b; b = a; a = first;
         vec4 colour = c_b; c_b = c_a; c_a = colour;
         vec4 filtered = f_b; f_b = f_a; f_a = filtered;
+        ivec2 offset = offset_b; offset_b = offset_a; offset_a = offset;
     }
     vec4 span = c_a - c_b;
     float span_sq = dot(span, span);
     float alpha = span_sq > TINY ? clamp(dot(c[0] - c_b, span) / span_sq, 0.0, 1.0) : 0.5;
     vec4 miss = alpha * c_a + (1.0 - alpha) * c_b - c[0];
     float residual = sqrt(dot(miss, miss));
-    float code = float(9 * a + b);
+    // The extremes' offsets as base-3 digits (x and y of a, then of b); jacobi.glsl decodes them.
+    float code = float((offset_a.x + 1) + 3 * (offset_a.y + 1) + 9 * (offset_b.x + 1) + 27 * (offset_b.y + 1));
 #if PURE_COLOURS
-    Extension ext_a = extend_extreme(c_a, c_b, p + OFFSETS[a], f_a, size);
-    Extension ext_b = extend_extreme(c_b, c_a, p + OFFSETS[b], f_b, size);
+    Extension ext_a = extend_extreme(c_a, c_b, p + offset_a, f_a, size);
+    Extension ext_b = extend_extreme(c_b, c_a, p + offset_b, f_b, size);
     if (ext_a.extended || ext_b.extended) {
         vec4 pure_span = ext_a.colour - ext_b.colour;
         float pure_span_sq = dot(pure_span, pure_span);

@@ -15,21 +15,25 @@ vec4 jacobi_step(ivec2 p, ivec2 size) {
     vec4 recovered = texelFetch(filtered_work, p, 0);
     // Most pixels are not edges (beta = 0): they keep F without gathering R.
     if (beta != 0.0) {
-        int code = int(model.z + 0.5);
+        // The extremes' offsets, two base-3 digits each (see blend_model.glsl), decoded in
+        // float arithmetic: integer division and indexing an array by a variable are
+        // scalar code on a CPU's vector units (llvmpipe).
+        float code = model.z;
 #if PURE_COLOURS
-        int pure = code / 81;  // bit 0: extreme a is a fixed pure colour, bit 1: extreme b
-        code -= 81 * pure;
+        float pure = floor((code + 0.5) * (1.0 / 81.0));  // 1: extreme a is a fixed pure colour, 2: b, 3: both
+        code -= 81.0 * pure;
 #endif
-        int a = code / 9;
-        int b = code - 9 * a;
+        vec4 digits = floor((code + 0.5) / vec4(1.0, 3.0, 9.0, 27.0));
+        vec4 offsets = digits - 3.0 * floor(digits * (1.0 / 3.0)) - 1.0;  // a.x, a.y, b.x, b.y in -1..1
+        ivec2 at_a_position = clamp_to_image(p + ivec2(offsets.xy), size);
+        ivec2 at_b_position = clamp_to_image(p + ivec2(offsets.zw), size);
 #if PURE_COLOURS
-        vec4 at_a = (pure & 1) != 0 ? texelFetch(fixed_a_map, p, 0)
-                                    : texelFetch(previous_iterate, clamp_to_image(p + OFFSETS[a], size), 0);
-        vec4 at_b = (pure & 2) != 0 ? texelFetch(fixed_b_map, p, 0)
-                                    : texelFetch(previous_iterate, clamp_to_image(p + OFFSETS[b], size), 0);
+        vec4 at_a = (pure == 1.0 || pure == 3.0) ? texelFetch(fixed_a_map, p, 0)
+                                                 : texelFetch(previous_iterate, at_a_position, 0);
+        vec4 at_b = pure >= 2.0 ? texelFetch(fixed_b_map, p, 0) : texelFetch(previous_iterate, at_b_position, 0);
 #else
-        vec4 at_a = texelFetch(previous_iterate, clamp_to_image(p + OFFSETS[a], size), 0);
-        vec4 at_b = texelFetch(previous_iterate, clamp_to_image(p + OFFSETS[b], size), 0);
+        vec4 at_a = texelFetch(previous_iterate, at_a_position, 0);
+        vec4 at_b = texelFetch(previous_iterate, at_b_position, 0);
 #endif
         recovered = beta * (alpha * at_a + (1.0 - alpha) * at_b) + (1.0 - beta) * recovered;
     }

@@ -8,6 +8,18 @@ uniform sampler2D original_work;
 uniform sampler2D filtered_work;
 uniform sampler2D filtered_image;  // F as given, for the colour of fully transparent pixels
 
+// Neighbour i (OFFSETS order) of pixel p in the working space. A compute pass that keeps its
+// block's neighbourhood in shared memory defines NEIGHBOURS_IN_SHARED_TILE and its own pair.
+#ifndef NEIGHBOURS_IN_SHARED_TILE
+vec4 original_neighbour(ivec2 p, int i, ivec2 size) {
+    return texelFetch(original_work, clamp_to_image(p + OFFSETS[i], size), 0);
+}
+
+vec4 filtered_neighbour(ivec2 p, int i, ivec2 size) {
+    return texelFetch(filtered_work, clamp_to_image(p + OFFSETS[i], size), 0);
+}
+#endif
+
 // Straight RGBA in the input encoding; a fully transparent result keeps F's colour, and a
 // pixel the recovery left exactly at F keeps F bit for bit (decode + encode is not exact).
 vec4 from_working(vec4 work, ivec2 p) {

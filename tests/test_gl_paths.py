@@ -1,0 +1,73 @@
+"""Choosing how the GL backend runs its passes: ``gl_path`` in the API and on the command line."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+import aarecovery
+from aarecovery import write_image
+from aarecovery.backends.gl.paths import available_paths, choose_path
+from aarecovery.cli import main
+
+
+def _context(version, renderer):
+    # The two facts the choice reads from a moderngl context.
+    return SimpleNamespace(version_code=version, info={"GL_RENDERER": renderer})
+
+
+@pytest.mark.parametrize("version, renderer, expected", [
+    (450, "llvmpipe (LLVM 15.0.6, 256 bits)", "fragment"),   # measured: fragment faster there
+    (460, "NVIDIA H100 80GB HBM3/PCIe/SSE2", "compute"),      # measured: compute ~19x faster
+    (410, "Apple M1", "fragment"),                            # macOS stops at GL 4.1
+    (330, "NVIDIA GeForce GTX 1080/PCIe/SSE2", "fragment"),
+])
+def test_auto_chooses_by_version_and_measured_rule(version, renderer, expected):
+    assert choose_path(_context(version, renderer)) == expected
+    assert choose_path(_context(version, renderer), "fragment") == "fragment"
+
+
+def test_compute_needs_gl_4_3():
+    assert available_paths(_context(420, "any")) == ("fragment",)
+    with pytest.raises(aarecovery.InputError, match="4.3.*offers 4.1.*gl_path='fragment'"):
+        choose_path(_context(410, "Apple M1"), "compute")
+
+
+def test_bad_gl_path_values_are_refused():
+    original = np.zeros((8, 8), np.uint8)
+    with pytest.raises(aarecovery.InputError, match="gl_path must be one of auto, fragment, compute, got 'vulkan'"):
+        aarecovery.recover(original, original, gl_path="vulkan")
+    with pytest.raises(aarecovery.InputError, match="backend='numpy'"):
+        aarecovery.Engine(backend="numpy", gl_path="compute")
+    assert aarecovery.GL_PATHS == ("auto", "fragment", "compute")
+
+
+@pytest.mark.gl
+def test_engine_reports_its_path_and_capabilities():
+    with aarecovery.Engine(backend="gl") as engine:
+        assert engine.gl_path in engine.capabilities.gl_paths
+        assert engine.capabilities.gl_path == engine.gl_path
+    with aarecovery.Engine(backend="numpy") as engine:
+        assert engine.gl_path is None and engine.capabilities.gl_paths == ()
+
+
+@pytest.mark.gl
+def test_command_line_gl_path(tmp_path, capsys):
+    rng = np.random.default_rng(3)
+    original = (rng.random((30, 41, 3)) * 255).astype(np.uint8)
+    filtered = np.where(original > 120, 255, 0).astype(np.uint8)
+    write_image(tmp_path / "o.png", original)
+    write_image(tmp_path / "f.png", filtered)
+    results = {}
+    for path in ("fragment", "compute"):
+        status = main(["recover", str(tmp_path / "o.png"), str(tmp_path / "f.png"), "-o",
+                       str(tmp_path / f"{path}.png"), "--backend", "gl", "--gl-path", path])
+        assert status == 0, capsys.readouterr().err
+        results[path] = aarecovery.read_image(tmp_path / f"{path}.png")
+    expected = aarecovery.recover(original, filtered, backend="numpy")
+    for result in results.values():
+        assert np.abs(result.astype(int) - expected).max() <= 1
+    status = main(["recover", str(tmp_path / "o.png"), str(tmp_path / "f.png"), "-o", str(tmp_path / "n.png"),
+                   "--backend", "numpy", "--gl-path", "compute"])
+    err = capsys.readouterr().err
+    assert status == 1 and err.startswith("aarecovery: error: ") and len(err.splitlines()) == 1
