@@ -15,15 +15,16 @@ in ``docs/architecture.md``.
 __version__ = "0.1.0"
 
 from . import filters
-from .backends.base import RecoveryMaps
+from .backends.base import Plan, RecoveryMaps
 from .backends import GLUnavailable
 from .engine import Engine
 from .errors import InputError, OrderWarning
 from .io import read_image, write_image
+from .outcome import RecoverySummary, summarize_recovery
 from .params import BACKENDS, BLEND_SPACES, GL_PATHS, MODES, PARAMETERS
 from .pipeline import recover
 from .plan.order import check_order
 
-__all__ = ["recover", "check_order", "Engine", "RecoveryMaps", "InputError", "GLUnavailable", "OrderWarning",
+__all__ = ["recover", "check_order", "summarize_recovery", "Engine", "Plan", "RecoveryMaps", "RecoverySummary", "InputError", "GLUnavailable", "OrderWarning",
            "read_image", "write_image", "filters", "PARAMETERS", "BACKENDS", "GL_PATHS", "MODES", "BLEND_SPACES",
            "__version__"]

@@ -6,7 +6,7 @@ from .backends import make_backend
 from .backends.base import RecoveryMaps
 from .contract import check_same_size, from_rgba_float, layout_of
 from .errors import InputError
-from .params import DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, Parameters, check_blend_space
+from .params import DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, STRENGTH, Parameters, check_blend_space
 from .plan import analyse_pair, make_plan
 
 __all__ = ["Engine", "RecoveryMaps"]
@@ -50,7 +50,8 @@ class Engine:
         self._analysis = None
         self.last_seconds = None
         #: Plan or None: what the last :meth:`compute` or :meth:`run` did (mode, blend space,
-        #: strength, and why).
+        #: strength, and why), or what :func:`aarecovery.recover` decided with this engine
+        #: (also when it returned F unchanged without running it).
         self.last_plan = None
 
     @property
@@ -137,7 +138,7 @@ class Engine:
             raise InputError("the last compute() kept no maps: call compute(maps=True) first")
 
     def plan(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
-             mode=DEFAULT_MODE):
+             mode=DEFAULT_MODE, strength=STRENGTH.default):
         """The Plan that :meth:`compute` would run for the loaded pair (analysed once per pair).
 
         Returns
@@ -146,14 +147,14 @@ class Engine:
         """
         self._require_images()
         original, _, filtered, _, linear, blend_space = self._pair
-        parameters = Parameters(sigma_d, sigma_e, iterations)
+        parameters = Parameters(sigma_d, sigma_e, iterations, strength)
         if mode == "safe" and self._analysis is None:
             self._analysis = analyse_pair(original, filtered, linear)
         return make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space,
                          analysis=self._analysis)
 
     def compute(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
-                maps=False, mode=DEFAULT_MODE):
+                maps=False, mode=DEFAULT_MODE, strength=STRENGTH.default):
         """Run the recovery and keep the result in the backend (on the GPU for GL).
 
         Parameters
@@ -168,8 +169,11 @@ class Engine:
             ``"safe"`` first analyses the loaded pair once (blend space, blur and point-wise
             detection, strength calibration; see :attr:`last_plan`) so that recovery does
             not make F worse; ``"paper"`` is Yang et al. (2011) exactly.
+        strength : float, optional
+            How much to repair, 0 to 1, instead of the strength the mode chooses.
         """
-        self.run(self.plan(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode), maps=maps)
+        self.run(self.plan(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode, strength=strength),
+                 maps=maps)
 
     def run(self, plan, *, maps=False, wait=True):
         """Run a resolved :class:`Plan` on the loaded pair; the result stays in the backend.
@@ -227,9 +231,9 @@ class Engine:
         return self._impl.start_readback(window)
 
     def recover(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
-                mode=DEFAULT_MODE):
+                mode=DEFAULT_MODE, strength=STRENGTH.default):
         """Compute and return R: :meth:`compute` then :meth:`result`."""
-        self.compute(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode)
+        self.compute(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode, strength=strength)
         return self.result()
 
     def maps(self):

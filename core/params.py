@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 from .errors import InputError
 
-__all__ = ["ParameterSpec", "PARAMETERS", "SIGMA_D", "SIGMA_E", "ITERATIONS", "Parameters", "MODES",
+__all__ = ["ParameterSpec", "PARAMETERS", "SIGMA_D", "SIGMA_E", "ITERATIONS", "STRENGTH", "Parameters", "MODES",
            "DEFAULT_MODE", "BLEND_SPACES", "BACKENDS", "GL_PATHS", "check_mode", "check_blend_space", "check_backend",
            "check_gl_path"]
 
@@ -38,6 +38,9 @@ class ParameterSpec:
         A short name for dialogs and sliders.
     help : str
         One line for ``--help`` and tooltips.
+    automatic : str
+        Empty for a parameter that always has a value. Otherwise None is a valid value (and
+        the default), meaning what this says: the safe default decides.
     """
 
     name: str
@@ -48,6 +51,7 @@ class ParameterSpec:
     logarithmic: bool
     label: str
     help: str
+    automatic: str = ""
 
     @property
     def option(self):
@@ -59,12 +63,15 @@ class ParameterSpec:
 
         NumPy scalars are accepted (``np.float32(0.1)``, ``np.int64(3)``); booleans are not.
         """
+        if value is None and self.automatic:
+            return None
         number = numbers.Integral if self.kind is int else numbers.Real
         if isinstance(value, bool) or not isinstance(value, number) or (
                 self.kind is float and not math.isfinite(value)) or not self.minimum <= value <= self.maximum:
+            usual = (f"leave it out for {self.automatic}" if self.automatic
+                     else f"the paper's value is {self.default:g}")
             raise InputError(f"{self.name} must be {'a whole number' if self.kind is int else 'a number'} "
-                             f"from {self.minimum:g} to {self.maximum:g}, got {value!r}; "
-                             f"the paper's value is {self.default:g}")
+                             f"from {self.minimum:g} to {self.maximum:g}, got {value!r}; {usual}")
         return self.kind(value)
 
 
@@ -80,8 +87,14 @@ ITERATIONS = ParameterSpec(
     "iterations", 3, 0, 64, int, False, "iterations",
     "Jacobi iterations of the recovery solve; 0 returns the filtered image")
 
+STRENGTH = ParameterSpec(
+    "strength", None, 0.0, 1.0, float, False, "strength",
+    "how much to repair, from 0 (F as it is) to 1 (the full repair); overrides the strength the "
+    "safe default chooses, and forces a repair where it keeps F",
+    automatic="the strength the safe default chooses per image")
+
 #: The parameters by name, in the order interfaces show them.
-PARAMETERS = {spec.name: spec for spec in (SIGMA_D, SIGMA_E, ITERATIONS)}
+PARAMETERS = {spec.name: spec for spec in (SIGMA_D, SIGMA_E, ITERATIONS, STRENGTH)}
 
 #: ``"safe"``: the default, with per-image safeguards (``aarecovery.plan``); ``"paper"``:
 #: Yang et al. 2011 exactly.
@@ -105,11 +118,14 @@ class Parameters:
     ----------
     sigma_d, sigma_e : float
     iterations : int
+    strength : float or None
+        None: the safe default's (the paper's 1 in paper mode).
     """
 
     sigma_d: float = SIGMA_D.default
     sigma_e: float = SIGMA_E.default
     iterations: int = ITERATIONS.default
+    strength: float = STRENGTH.default
 
     def __post_init__(self):
         for spec in PARAMETERS.values():

@@ -14,8 +14,8 @@ from .contract import check_same_size, check_values, from_rgba_float, layout_of
 from .engine import Engine
 from .errors import NotEnoughMemory, OrderWarning
 from .memory import not_enough_memory
-from .params import (DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, Parameters, check_blend_space, check_gl_path,
-                     check_mode)
+from .params import (DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, STRENGTH, Parameters, check_blend_space,
+                     check_gl_path, check_mode)
 from .plan import make_plan
 from .plan.order import check_order
 from .tiling import DEFAULT_TILES, check_tile_size, halo_for, tiles
@@ -25,7 +25,7 @@ __all__ = ["recover"]
 
 def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
             backend="auto", linear=False, blend_space=None, return_maps=False, tile_size=None, engine=None,
-            mode=DEFAULT_MODE, gl_path="auto"):
+            mode=DEFAULT_MODE, gl_path="auto", strength=STRENGTH.default):
     """Repair the antialiased edges of `filtered` using the edges of `original`.
 
     Parameters
@@ -55,7 +55,8 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
         Largest tile side; images larger than this are processed in overlapping tiles whose
         result equals the untiled one. By default the backend's own limit.
     engine : Engine, optional
-        An engine to reuse (its backend and GL path win over `backend` and `gl_path`).
+        An engine to reuse (its backend and GL path win over `backend` and `gl_path`); its
+        ``last_plan`` then says what was decided, for :func:`aarecovery.summarize_recovery`.
     mode : {"safe", "paper"}, optional
         ``"safe"`` (the default) analyses the whole pair once before tiling: it picks the
         blend space, leaves blurred images alone, and calibrates the repair strength so that
@@ -64,6 +65,11 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     gl_path : {"auto", "fragment", "compute"}, optional
         How the GL backend runs its passes (``aarecovery.params.GL_PATHS``); ``"auto"``
         chooses by the GL version and a measured rule.
+    strength : float, optional
+        How much to repair, from 0 (`filtered` as it is) to 1 (the full repair), instead of
+        the strength the mode chooses (``"safe"``: per image; ``"paper"``: 1). It also
+        forces a repair where the safe default would keep `filtered` (a blur, a photo under
+        a neighbourhood filter).
 
     Returns
     -------
@@ -95,7 +101,7 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     o_layout = layout_of(original, "original")
     f_layout = layout_of(filtered, "filtered")
     check_same_size(o_layout, f_layout)
-    parameters = Parameters(sigma_d, sigma_e, iterations)
+    parameters = Parameters(sigma_d, sigma_e, iterations, strength)
     check_mode(mode)
     check_gl_path(gl_path)
     if blend_space is not None:
@@ -111,6 +117,8 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     try:
         plan = make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space)
         if plan.keeps_filtered and not return_maps:
+            if engine is not None:
+                engine.last_plan = plan
             return filtered.copy()
     except MemoryError as error:
         name = engine.backend if engine is not None else "gl" if backend == "auto" else backend

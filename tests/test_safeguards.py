@@ -91,6 +91,12 @@ def test_grain_tells_rendered_content_from_photographs():
     photo = make_case(_scenes.render("astronaut", 96, 4), "gamma", 4, "linear").original
     grey = np.repeat(photo.mean(axis=-1, keepdims=True), 3, axis=-1)
     assert grain(photo) > GRAIN_SHARE and grain(grey) > GRAIN_SHARE
+    # A drawing on a soft gradient (about a level per pixel) is still a drawing, in colour
+    # and in grey (the 3 x 3 range alone called it a photo: 0.73 and 0.23 of quiet pixels).
+    from scenes import disc_and_bar
+    gradient = (np.rint(disc_and_bar(80, 112)[..., :3] * 255) / 255).astype(np.float32)
+    grey = np.repeat(np.rint(gradient @ np.float32([0.2126, 0.7152, 0.0722]) * 255)[..., None] / 255, 3, axis=-1)
+    assert grain(gradient) < GRAIN_SHARE and grain(grey.astype(np.float32)) < GRAIN_SHARE
 
 
 def test_a_grey_photograph_under_an_exposure_boost_is_not_destroyed():

@@ -158,6 +158,7 @@ class ViewerApp:
         now = time.perf_counter()
         self.messages.expire(now)
         self.comparison.tick(now)
+        self.recovery.refresh_summary(now)
 
         self.platform.new_frame()
         imgui.new_frame()

@@ -39,8 +39,9 @@ def register(subparsers):
                         help="built-in filter that makes F from ORIGINAL when FILTERED is not given "
                              "(see the panel's list; default posterize)")
     for spec in PARAMETERS.values():
+        default = f"default: {spec.automatic}" if spec.automatic else "default %(default)s"
         parser.add_argument(spec.option, type=spec.kind, default=spec.default, metavar="N" if spec.kind is int else "X",
-                            help=f"initial {spec.label} ({spec.minimum:g} to {spec.maximum:g}, default %(default)s)")
+                            help=f"initial {spec.label} ({spec.minimum:g} to {spec.maximum:g}; {default})")
     parser.add_argument("--view", choices=[mode for mode, _, _ in _VIEW_NAMES], default="result",
                         help="what the window shows first (keys 1 to 9 switch; default %(default)s)")
     parser.add_argument("--size", default="1280x720", metavar="WxH", help="window size (default %(default)s)")

@@ -1,5 +1,7 @@
 """The engine kept current: it re-runs the recovery when the settings change, and only then."""
 
+import time
+
 import aarecovery
 
 from .settings import RecoverySettings
@@ -32,7 +34,14 @@ class LiveRecovery:
         run on a pair.
     recoveries : int
         How many times the recovery ran.
+    summary : aarecovery.RecoverySummary or None
+        What the shown R repaired (``aarecovery.summarize_recovery``), once the settings have
+        rested :data:`SUMMARY_DELAY` seconds: it reads R back, which a slider drag should not
+        pay on every frame.
     """
+
+    #: Seconds a result must stay shown before its summary is made.
+    SUMMARY_DELAY = 0.3
 
     def __init__(self, engine, messages, maps_wanted, settings=None):
         self.engine = engine
@@ -44,6 +53,9 @@ class LiveRecovery:
         self.recoveries = 0
         #: aarecovery.check_order's verdict on the pair shown (None before the first pair).
         self.order = None
+        self.summary = None
+        self._summarized = None
+        self._computed_at = 0.0
 
     def load(self, pair):
         """Load `pair` into the engine and show it from the next update.
@@ -56,6 +68,7 @@ class LiveRecovery:
         self.engine.set_images(pair.original, pair.filtered)
         self.pair = pair
         self.computed = None
+        self.summary = self._summarized = None
         self.order = aarecovery.check_order(pair.original, pair.filtered)
 
     def restore_shown_pair(self):
@@ -89,5 +102,25 @@ class LiveRecovery:
             self.settings = self.computed[0] if self.computed else RecoverySettings.defaults()
             return False
         self.computed = (self.settings, maps)
+        self._computed_at = time.perf_counter()
         self.recoveries += 1
+        return True
+
+    def refresh_summary(self, now=None):
+        """Summarize the shown R once it has been shown :data:`SUMMARY_DELAY` seconds.
+
+        Returns
+        -------
+        bool
+            True when a new summary was made.
+        """
+        now = time.perf_counter() if now is None else now
+        if self.computed is None or self.computed == self._summarized:
+            return False
+        if now - self._computed_at < self.SUMMARY_DELAY:
+            return False
+        result = self.engine.result()
+        self.summary = aarecovery.summarize_recovery(self.engine.last_plan, self.pair.original, self.pair.filtered,
+                                                     result)
+        self._summarized = self.computed
         return True

@@ -28,7 +28,9 @@ class RecoverySettings:
     ----------
     sigma_d, sigma_e : float
     iterations : int
-        As in ``aarecovery.PARAMETERS``, whose defaults they start at.
+    strength : float or None
+        As in ``aarecovery.PARAMETERS``, whose defaults they start at (strength None: the
+        mode's own).
     mode : str
         One of ``aarecovery.MODES``.
     """
@@ -36,6 +38,7 @@ class RecoverySettings:
     sigma_d: float = aarecovery.PARAMETERS["sigma_d"].default
     sigma_e: float = aarecovery.PARAMETERS["sigma_e"].default
     iterations: int = aarecovery.PARAMETERS["iterations"].default
+    strength: object = aarecovery.PARAMETERS["strength"].default
     mode: str = DEFAULT_MODE
 
     @classmethod
@@ -104,7 +107,8 @@ def command_line(source, settings, output):
         steps.append(_filter_step(source, filtered))
     argv = ["recover", os.fspath(source.original), os.fspath(filtered), "-o", os.fspath(output)]
     for name, spec in aarecovery.PARAMETERS.items():
-        argv += [spec.option, _number(getattr(settings, name))]
+        if getattr(settings, name) is not None:
+            argv += [spec.option, _number(getattr(settings, name))]
     argv += MODE_OPTIONS[settings.mode]
     steps.append(_command(argv))
     return " && ".join(steps)

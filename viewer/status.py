@@ -29,48 +29,57 @@ _FIGURES = re.compile(r"\s*\([^()]*\)")
 _CLAUSE_END = re.compile(r"[:;,]")
 
 
-def _finding(engine):
+def _finding(engine, summary):
     """What the plan found: the first clause of its reason (``point-wise filter ...``)."""
     return _CLAUSE_END.split(_FIGURES.sub("", engine.last_plan.reason), maxsplit=1)[0].strip() or None
 
 
-def _strength(engine):
+def _strength(engine, summary):
     strength = engine.last_plan.strength
     if strength == 0:
         return "F shown unchanged"
     return "full strength" if strength == 1 else f"strength {strength:.2g}"
 
 
-def _blend_space(engine):
+def _blend_space(engine, summary):
     plan = engine.last_plan
     if plan.strength == 0:
         return None
     return "blend in sRGB" if plan.blend_space == "srgb" else "blend in linear light"
 
 
-def _how_to_force(engine):
+def _how_to_force(engine, summary):
     plan = engine.last_plan
-    if plan.strength == 0 and plan.mode != "paper":
-        return "switch to paper mode to force a repair"
+    if plan.strength == 0:
+        return "untick auto strength to force a repair"
     return None
 
 
+def _repaired_share(engine, summary):
+    """The share of edge pixels repaired, once the shown R has been summarized."""
+    if summary is None or summary.plan != engine.last_plan or engine.last_plan.strength == 0:
+        return None
+    return f"{summary.edge_share:.0%} of edge pixels repaired"
+
+
 #: The phrases of the plan line, in order. Each takes the engine after a run (its
-#: ``last_plan`` and whatever else it reports) and returns a short phrase, or None to say
-#: nothing. A new figure, such as the share of edge pixels repaired, is one more function here.
-PLAN_PHRASES = (_finding, _strength, _blend_space, _how_to_force)
+#: ``last_plan``) and the summary of the shown R (``aarecovery.RecoverySummary`` or None
+#: while it is being made) and returns a short phrase, or None to say nothing.
+PLAN_PHRASES = (_finding, _repaired_share, _strength, _blend_space, _how_to_force)
 
 
-def plan_line(engine):
+def plan_line(engine, summary=None):
     """What the engine's last run did, as one :class:`StatusLine`, or None before the first run.
 
     Parameters
     ----------
     engine : aarecovery.Engine
+    summary : aarecovery.RecoverySummary, optional
+        What the shown R repaired (``LiveRecovery.summary``).
     """
     if engine.last_plan is None:
         return None
-    phrases = [phrase for phrase in (describe(engine) for describe in PLAN_PHRASES) if phrase]
+    phrases = [phrase for phrase in (describe(engine, summary) for describe in PLAN_PHRASES) if phrase]
     return StatusLine(f"{engine.last_plan.mode}: {', '.join(phrases)}", engine.last_plan.reason)
 
 
@@ -91,7 +100,7 @@ def status_lines(app):
     if pair is not None:
         width, height = pair.size
         lines.append(StatusLine(f"{width} x {height}  {pair.filtered.dtype}  backend {engine.backend}"))
-        plan = plan_line(engine)
+        plan = plan_line(engine, app.recovery.summary)
         if plan is not None:
             lines.append(plan)
         order = app.recovery.order

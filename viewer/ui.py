@@ -155,7 +155,25 @@ def _slider(app, key, label, value, minimum, maximum, display_format, flags=0, h
 
 
 def _parameter_slider(app, spec, value):
-    """A slider over one parameter's valid range, with its label and help from ``PARAMETERS``."""
+    """A slider over one parameter's valid range, with its label and help from ``PARAMETERS``.
+
+    A parameter the safe default may choose (``spec.automatic``, the strength) has an
+    "auto" box first: ticked, the value is None and the status line says what was chosen;
+    unticked, the slider starts at what the last run used.
+    """
+    if spec.automatic:
+        automatic = value is None
+        changed, automatic = imgui.checkbox(f"auto##{spec.name}", automatic)
+        _record(app, f"{spec.name} auto")
+        if imgui.is_item_hovered():
+            imgui.set_tooltip(f"ticked: {spec.automatic}")
+        imgui.same_line()
+        if automatic:
+            imgui.text_colored(_DIM, spec.label)
+            return None
+        if value is None:
+            plan = app.recovery.engine.last_plan if app.recovery.engine is not None else None
+            value = plan.strength if plan is not None else spec.maximum
     flags = imgui.SliderFlags_.always_clamp
     if spec.logarithmic:
         flags |= imgui.SliderFlags_.logarithmic

@@ -4,7 +4,7 @@ import argparse
 import ast
 
 from ..errors import InputError
-from ..params import BACKENDS
+from ..params import BACKENDS, STRENGTH
 from .inputs import add_image_memory_option
 
 __all__ = ["register", "parse_params"]
@@ -15,6 +15,7 @@ examples:
   aarecovery filter threshold scan.png -o bw.png --param level=0.45
   aarecovery filter posterize photo.png -o poster.png --param steps=3 --recover
   aarecovery filter gradientmap photo.png -o mapped.png --recover --paper
+  aarecovery filter threshold photo.png -o bw.png --recover --strength 0.5
 """
 
 
@@ -35,6 +36,10 @@ def register(subparsers):
                                                              "without the safe default's safeguards")
     parser.add_argument("--backend", choices=BACKENDS, default="auto",
                         help="recovery backend (default auto)")
+    strength = STRENGTH
+    parser.add_argument(strength.option, type=strength.kind, metavar="X",
+                        help=f"with --recover: {strength.help} ({strength.minimum:g} to {strength.maximum:g}; "
+                             f"default: {strength.automatic})")
     add_image_memory_option(parser)
     parser.add_argument("--overwrite", action="store_true",
                         help="allow OUTPUT to replace INPUT (the original that --recover, or a later "
@@ -93,13 +98,29 @@ def _run_filter(args):
     params = parse_params(args.param, spec)
     if args.paper and not args.recover:
         raise InputError("--paper only applies with --recover; add --recover or drop --paper")
+    if args.strength is not None and not args.recover:
+        raise InputError("--strength only applies with --recover; add --recover or drop --strength")
+    STRENGTH.check(args.strength)
     check_destinations([args.output], {"input": args.input}, overwrite=args.overwrite)
     remove_stale_parts_of([args.output])
     image = read_input(args.input, args)
     filtered = filters.apply(spec.name, image, **params)
+    summary = None
     if args.recover:
+        from ..engine import Engine
         from ..pipeline import recover
-        filtered = recover(image, filtered, backend=args.backend, mode="paper" if args.paper else "safe")
+        from .recover import summary_line
+        engine = Engine(args.backend)
+        try:
+            recovered = recover(image, filtered, engine=engine, mode="paper" if args.paper else "safe",
+                                strength=args.strength)
+            plan = engine.last_plan
+        finally:
+            engine.release()
+        summary = summary_line(plan, image, filtered, recovered)
+        filtered = recovered
     write_image(args.output, filtered)
     print(f"wrote {args.output}")
+    if summary is not None:
+        print(summary)
     return 0

@@ -9,7 +9,7 @@ from ..params import BACKENDS, BLEND_SPACES, GL_PATHS, PARAMETERS
 from ..tiling import DEFAULT_TILES, SENSIBLE_TILE
 from .inputs import add_image_memory_option
 
-__all__ = ["register", "run", "MAP_SCALES"]
+__all__ = ["register", "run", "summary_line", "add_parameter_options", "MAP_SCALES"]
 
 #: Factor each map is multiplied by before it is clipped to [0, 1] and stored as 16-bit
 #: grey; ``"sqrt"`` stores the square root, the geometric mean of O's and F's Sobel
@@ -85,10 +85,11 @@ def register(subparsers):
 
 
 def add_parameter_options(parser):
-    """``--sigma-d``, ``--sigma-e`` and ``--iterations``, from ``aarecovery.params``."""
+    """``--sigma-d``, ``--sigma-e``, ``--iterations`` and ``--strength``, from ``aarecovery.params``."""
     for spec in PARAMETERS.values():
+        default = f"default: {spec.automatic}" if spec.automatic else "default %(default)s"
         parser.add_argument(spec.option, type=spec.kind, default=spec.default, metavar="N" if spec.kind is int else "X",
-                            help=f"{spec.help} ({spec.minimum:g} to {spec.maximum:g}, default %(default)s)")
+                            help=f"{spec.help} ({spec.minimum:g} to {spec.maximum:g}; {default})")
 
 
 def _map_paths(folder):
@@ -126,7 +127,7 @@ def run(args):
     from ..tiling import check_tile_size
     from .outputs import check_destinations, remove_stale_parts_of
 
-    params = Parameters(args.sigma_d, args.sigma_e, args.iterations)
+    params = Parameters(args.sigma_d, args.sigma_e, args.iterations, args.strength)
     if args.tile_size is not None:
         check_tile_size(args.tile_size, params.iterations, name="--tile-size")
     check_output_path(args.output)
@@ -150,9 +151,10 @@ def run(args):
         result = recover(original, filtered, sigma_d=params.sigma_d, sigma_e=params.sigma_e,
                          iterations=params.iterations, linear=args.linear, blend_space=args.blend_space,
                          return_maps=args.maps is not None, tile_size=args.tile_size, engine=engine,
-                         mode="paper" if args.paper else "safe")
+                         mode="paper" if args.paper else "safe", strength=params.strength)
         seconds = time.perf_counter() - start
         backend = engine.backend
+        plan = engine.last_plan
     finally:
         engine.release()
     maps = None
@@ -170,4 +172,12 @@ def run(args):
     if args.maps is not None:
         message += f"; maps in {args.maps}"
     print(message)
+    print(summary_line(plan, original, filtered, result))
     return 0
+
+
+def summary_line(plan, original, filtered, recovered):
+    """What the recovery did, in the command line's words."""
+    from ..outcome import summarize_recovery
+
+    return summarize_recovery(plan, original, filtered, recovered).line(force="--strength 1")

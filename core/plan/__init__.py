@@ -41,10 +41,17 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
     if blend_space is not None:
         check_blend_space(blend_space)
     common = dict(sigma_d=parameters.sigma_d, sigma_e=parameters.sigma_e, iterations=parameters.iterations)
+    asked = parameters.strength
     if mode == "paper":
         return Plan(**common, blend_space=blend_space or "linear", mode="paper",
-                    reason="the published method (Yang et al. 2011), without the safe default's analysis")
+                    strength=1.0 if asked is None else asked,
+                    reason="the published method (Yang et al. 2011), without the safe default's analysis"
+                           + ("" if asked is None else f"; strength {asked:g} as asked"))
     if analysis is None:
         analysis = analyse_pair(original, filtered, linear)
-    return Plan(**common, blend_space=blend_space or analysis.blend_space, strength=analysis.strength,
-                pure_colours=analysis.pure_colours, mode="safe", reason=analysis.reason)
+    # A strength the user gives overrides the analysis's, and forces a repair where it keeps
+    # F; the other decisions (blend space, pure colours) stand.
+    return Plan(**common, blend_space=blend_space or analysis.blend_space,
+                strength=analysis.strength if asked is None else asked, pure_colours=analysis.pure_colours,
+                mode="safe", reason=analysis.reason + ("" if asked is None else
+                                                       f"; strength {asked:g} as asked instead"))

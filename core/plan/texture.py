@@ -8,11 +8,16 @@ Two measures, each where it works:
   photos' do not (0.018-0.053). Grey images have no colour to leave the line: their
   residual is always 0.
 * **Grain**: pixels away from every edge (nothing steeper than a Sobel / 8 of 0.03 within
-  4 pixels) are exactly flat in rendered content and carry sensor noise and fine texture in
-  photos. Measured on the real-tools crops and the built-in scenes: every PNG drawing 0.00 of
-  such pixels with a 3 x 3 range of 2 levels or more, every photo 0.40-1.00 (grey ones
-  0.53-1.00). JPEG adds its own noise there (drawings 0.15-0.98), so a JPEG drawing reads as
-  a photo: it gets the photo treatment, which is never worse than F, not the hard-edged one.
+  4 pixels) are flat or smooth gradients in rendered content and carry sensor noise and fine
+  texture in photos. A quiet pixel is grainy when its 3 x 3 neighbourhood spans 2 levels or
+  more and so does its high-pass (O minus its 3 x 3 mean, which a linear gradient leaves at
+  zero but for rounding) by more than one level. Measured on the real-tools crops and the
+  built-in scenes: every PNG drawing 0.00-0.01 of quiet pixels grainy, every photo
+  0.28-1.00 (a 96-pixel photo crop 0.07); JPEG adds its own noise there (drawings
+  0.15-0.98), so a JPEG drawing reads as a photo: it gets the photo treatment, which is
+  never worse than F, not the hard-edged one. The range alone, used before, called a drawing
+  on a soft gradient a photo (0.23 grey, 0.73 in colour: the GIMP tests' scene); the
+  high-pass alone called the serif page's flat paper 0.06 grainy.
 
 Content is hard-edged when both say so (the colour test only where O has colour).
 """
@@ -27,11 +32,12 @@ __all__ = ["grain", "is_textured", "STRICT_RESIDUAL", "GRAIN_SHARE"]
 #: grain cannot be measured (every pixel is near an edge): the built-in line scene has
 #: 0.0014-0.0017, a JPEG star field (Hubble, q 85) 0.010-0.018.
 STRICT_RESIDUAL = 0.008
-#: Share of quiet pixels (away from edges) with a visible 3 x 3 range above which O is a photo.
+#: Share of grainy quiet pixels (away from edges) above which O is a photo.
 GRAIN_SHARE = 0.05
 _QUIET_GRADIENT = 0.03
 _QUIET_DISTANCE = 4
 _GRAIN_RANGE = 1.5 / 255
+_GRAIN_HIGH_PASS = 1.0 / 255
 # Fewer quiet pixels than this leave the grain undecided (dense drawings have none).
 _MIN_QUIET = 64
 
@@ -46,8 +52,15 @@ def _spread(mask, radius):
     return out
 
 
+def _neighbours(image):
+    height, width = image.shape[:2]
+    padded = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    return [padded[1 + dy:1 + dy + height, 1 + dx:1 + dx + width] for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
+
+
 def grain(encoded):
-    """Share of pixels away from every edge whose 3 x 3 neighbourhood is not flat.
+    """Share of pixels away from every edge whose 3 x 3 neighbourhood is neither flat nor a
+    smooth gradient.
 
     Parameters
     ----------
@@ -62,11 +75,12 @@ def grain(encoded):
     quiet = ~_spread(gradient_magnitude(encoded) > _QUIET_GRADIENT, _QUIET_DISTANCE)
     if quiet.sum() < _MIN_QUIET:
         return None
-    height, width = encoded.shape[:2]
-    padded = np.pad(encoded, ((1, 1), (1, 1), (0, 0)), mode="edge")
-    window = [padded[1 + dy:1 + dy + height, 1 + dx:1 + dx + width] for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
+    window = _neighbours(encoded)
     spread = (np.max(window, axis=0) - np.min(window, axis=0)).max(axis=-1)
-    return float((spread[quiet] > _GRAIN_RANGE).mean())
+    high_pass = _neighbours(encoded - np.mean(window, axis=0))
+    high_pass_spread = (np.max(high_pass, axis=0) - np.min(high_pass, axis=0)).max(axis=-1)
+    grainy = (spread > _GRAIN_RANGE) & (high_pass_spread > _GRAIN_HIGH_PASS)
+    return float(grainy[quiet].mean())
 
 
 def is_textured(encoded, colour_line_residual):

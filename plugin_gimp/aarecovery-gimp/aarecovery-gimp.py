@@ -51,6 +51,12 @@ def read_config():
     return data if isinstance(data, dict) else {}
 
 ORDER_MARK = "order: "
+# The recovery's one-line summary travels among the messages too: SUMMARY_MARK when it
+# repaired, KEPT_MARK when it returned F unchanged (which the user is told in a message).
+SUMMARY_MARK = "summary: "
+KEPT_MARK = "kept: "
+# How the summary tells a user of the plug-in to force a repair.
+FORCE_HINT = "the dialog's Strength with Automatic strength unticked (auto-strength=FALSE, strength=1)"
 
 
 # ---------------------------------------------------------------------------------------------
@@ -60,9 +66,11 @@ ORDER_MARK = "order: "
 def recover_arrays(original, filtered, params):
     """Run ``aarecovery.recover`` on float32 arrays; return ``(result, backend, messages)``.
 
-    ``params`` holds sigma_d, sigma_e, iterations, backend, linear and clip_filtered (a GIMP
-    filter may overshoot [0, 1] on a float image; integer precisions clip it anyway, so the
-    apply-filter entry clips to match). Raises aarecovery.InputError on bad input.
+    ``params`` holds sigma_d, sigma_e, iterations, strength (None: the safe default's),
+    backend, linear and clip_filtered (a GIMP filter may overshoot [0, 1] on a float image;
+    integer precisions clip it anyway, so the apply-filter entry clips to match). The last
+    message is the recovery's summary (SUMMARY_MARK or KEPT_MARK). Raises
+    aarecovery.InputError on bad input.
     """
     import numpy as np
     import aarecovery
@@ -79,6 +87,8 @@ def recover_arrays(original, filtered, params):
     # of its own; the rest (the GL fallback) goes to the status bar.
     messages = [(ORDER_MARK if issubclass(w.category, aarecovery.OrderWarning) else "") + str(w.message)
                 for w in caught]
+    summary = aarecovery.summarize_recovery(engine.last_plan, original, filtered, result)
+    messages.append((KEPT_MARK if summary.plan.keeps_filtered else SUMMARY_MARK) + summary.line(force=FORCE_HINT))
     return np.ascontiguousarray(result, dtype=np.float32), engine.backend, messages
 
 
@@ -193,6 +203,8 @@ BACKENDS = ("auto", "gl", "numpy")
 # The recovery parameters as the core declares them in aarecovery.PARAMETERS. GIMP's Python may
 # not be able to import the core, so they are repeated here; tests/gimp/test_install.py checks
 # that they match. (GIMP argument name, dialog label, kind, minimum, maximum, default, help.)
+# A default of None means the safe default chooses: the dialog then has a box ticked for that
+# (AUTOMATIC_ARGUMENTS: its argument name, label and help), and the value starts at the maximum.
 RECOVERY_ARGUMENTS = (
     ("sigma-d", "Sigma _d", "float", 0.001, 1.0, 0.1,
      "colour-line distance scale: neighbours further than 3 sigma_d from the colour line are "
@@ -203,7 +215,13 @@ RECOVERY_ARGUMENTS = (
      "smaller repairs weaker edges"),
     ("iterations", "_Iterations", "int", 0, 64, 3,
      "Jacobi iterations of the recovery solve; 0 returns the filtered image"),
+    ("strength", "_Strength", "float", 0.0, 1.0, None,
+     "how much to repair, from 0 (F as it is) to 1 (the full repair); overrides the strength the "
+     "safe default chooses, and forces a repair where it keeps F"),
 )
+AUTOMATIC_ARGUMENTS = {
+    "strength": ("auto-strength", "_Automatic strength", "the strength the safe default chooses per image"),
+}
 
 
 # ---- pixels ----------------------------------------------------------------------------------
@@ -541,7 +559,9 @@ def check_aligned(original, filtered):
 
 
 def core_params(config, linear, clip_filtered):
-    recovery = {name.replace("-", "_"): config.get_property(name) for name, *_ in RECOVERY_ARGUMENTS}
+    recovery = {name.replace("-", "_"): None if name in AUTOMATIC_ARGUMENTS and config.get_property(
+                    AUTOMATIC_ARGUMENTS[name][0]) else config.get_property(name)
+                for name, *_ in RECOVERY_ARGUMENTS}
     return {**recovery, "backend": config.get_property("backend"), "linear": linear,
             "clip_filtered": clip_filtered}
 
@@ -580,24 +600,31 @@ def grab(image, procedure_name, layer, config):
 
 
 def recover_layer(procedure_name, image, layer, config):
-    """Do the whole job on `layer` inside one undo group; return (backend, where, folders)."""
+    """Do the whole job on `layer` inside one undo group; return (backend, where, folders, summary)."""
     Gimp.progress_init("Antialiasing recovery")
     image.undo_group_start()
     try:
         fmt, o, o_shape, f, f_shape, params = grab(image, procedure_name, layer, config)
         data, backend, where, messages, folders = run_core(o, o_shape, f, f_shape, params, config)
         write_pixels(layer, fmt, data)
+        summary = ""
         for message in messages:
-            if message.startswith(ORDER_MARK):
-                Gimp.message(f"aarecovery: {message[len(ORDER_MARK):]}")
-        notes = [message for message in messages if not message.startswith(ORDER_MARK)]
-        if notes:
-            # The GL fallback note goes to the status bar, not a dialog: the result is right.
-            Gimp.progress_set_text(f"aarecovery: {notes[-1]}")
+            # A swapped pair and an unchanged result need the user: a message each.
+            for mark in (ORDER_MARK, KEPT_MARK):
+                if message.startswith(mark):
+                    Gimp.message(f"aarecovery: {message[len(mark):]}")
+            for mark in (SUMMARY_MARK, KEPT_MARK):
+                if message.startswith(mark):
+                    summary = message[len(mark):]
+        notes = [message for message in messages
+                 if not message.startswith((ORDER_MARK, SUMMARY_MARK, KEPT_MARK))]
+        # The repair's summary (or the GL fallback note) goes to the status bar, not a dialog.
+        if notes or summary:
+            Gimp.progress_set_text(f"aarecovery: {(notes or [summary])[-1]}")
     finally:
         image.undo_group_end()
         Gimp.progress_end()
-    return backend, where, folders
+    return backend, where, folders, summary
 
 
 # ---- dialog ----------------------------------------------------------------------------------
@@ -606,7 +633,9 @@ def show_dialog(procedure, config, image, layer):
     """The ProcedureDialog with an on-canvas preview toggle; returns True on OK."""
     GimpUi.init(PLUGIN)
     dialog = GimpUi.ProcedureDialog.new(procedure, config, procedure.get_menu_label())
-    names = [name for name, *_ in RECOVERY_ARGUMENTS] + ["backend", "python"]
+    names = [part for name, *_ in RECOVERY_ARGUMENTS
+             for part in ([AUTOMATIC_ARGUMENTS[name][0]] if name in AUTOMATIC_ARGUMENTS else []) + [name]]
+    names += ["backend", "python"]
     if procedure.get_name() == PROC_FILTER:
         names = ["filter", "operation", "properties"] + names
 
@@ -677,7 +706,7 @@ def run(procedure, run_mode, image, drawables, config, data):
         if run_mode == Gimp.RunMode.INTERACTIVE:
             if not show_dialog(procedure, config, image, layer):
                 return procedure.new_return_values(Gimp.PDBStatusType.CANCEL, GLib.Error())
-        backend, where, folders = recover_layer(procedure.get_name(), image, layer, config)
+        backend, where, folders, summary = recover_layer(procedure.get_name(), image, layer, config)
     except PluginError as error:
         return procedure.new_return_values(Gimp.PDBStatusType.EXECUTION_ERROR, GLib.Error(str(error)))
     except Exception as error:            # a bug: still a message, never a silent failure
@@ -689,7 +718,7 @@ def run(procedure, run_mode, image, drawables, config, data):
     Gimp.displays_flush()
     values = procedure.new_return_values(Gimp.PDBStatusType.SUCCESS, GLib.Error())
     for index, value in ((1, backend), (2, where), (3, folders["aarecovery"]),
-                         (4, folders["numpy"])):
+                         (4, folders["numpy"]), (5, summary)):
         values.remove(index)
         values.insert(index, GObject.Value(GObject.TYPE_STRING, value))
     return values
@@ -741,6 +770,11 @@ class AntialiasingRecovery(Gimp.PlugIn):
                                          True, flags)
         procedure.add_menu_path("<Image>/Filters/Enhance")        # after the label: GIMP needs it
         for name, label, kind, minimum, maximum, default, blurb in RECOVERY_ARGUMENTS:
+            if default is None:
+                automatic, automatic_label, automatic_blurb = AUTOMATIC_ARGUMENTS[name]
+                procedure.add_boolean_argument(automatic, automatic_label,
+                                               f"Ticked: {automatic_blurb}; unticked: the value below", True, flags)
+                default = maximum
             add = procedure.add_int_argument if kind == "int" else procedure.add_double_argument
             add(name, label, blurb[0].upper() + blurb[1:], minimum, maximum, default, flags)
         backends = Gimp.Choice.new()
@@ -758,6 +792,8 @@ class AntialiasingRecovery(Gimp.PlugIn):
                                           "The folder the core was imported from", "", flags)
         procedure.add_string_return_value("numpy-path", "NumPy path",
                                           "The folder NumPy was imported from", "", flags)
+        procedure.add_string_return_value("summary", "Summary",
+                                          "What the recovery did, in one line", "", flags)
         return procedure
 
 

@@ -142,6 +142,7 @@ def run_case(case, out):
         if status == Gimp.PDBStatusType.SUCCESS:
             record["backend"], record["runner"] = result.index(1), result.index(2)
             record["aarecovery_path"], record["numpy_path"] = result.index(3), result.index(4)
+            record["summary"] = result.index(5)
             export_layer(image, target, f"{out}/{name}-R.{ext}")
         else:
             record["message"] = result.index(1) if result.length() > 1 else None

@@ -133,6 +133,7 @@ def build_cases(workdir, inside):
         layer_case("layer-rgba-float-linear", "rgba", 16, precision="FLOAT_LINEAR", ext="tif"),
         layer_case("layer-rgb8-feathered-selection", "rgb", 8, selection=ellipse,
                    original_arg=True),
+        layer_case("layer-rgb8-strength", "rgb", 8, args={**SIGMAS, "auto-strength": False, "strength": 0.4}),
         filter_case("filter-threshold-rgba8", "rgba", 8, THRESHOLD,
                     {"kind": "threshold", "low": 0.5, "high": 1.0}),
         filter_case("filter-posterize-grey16", "grey", 16,
@@ -190,7 +191,7 @@ def build_cases(workdir, inside):
     ]
 
 
-OUT_OF_PROCESS = ("layer-rgb8", "layer-rgb8-feathered-selection", "filter-threshold-rgba8",
+OUT_OF_PROCESS = ("layer-rgb8", "layer-rgb8-feathered-selection", "layer-rgb8-strength", "filter-threshold-rgba8",
                   "filter-unsharp-float", "error-offset-layer")
 NO_GL = ("layer-rgb8", "filter-threshold-rgba8")
 BUNDLED = ("layer-rgb8", "layer-greya8", "layer-rgba-float-linear", "layer-rgb8-feathered-selection",
@@ -306,7 +307,7 @@ def bundled_run(installed_root):
 CASE_NAMES = [
     "layer-rgb8", "layer-rgba8", "layer-grey8", "layer-greya8", "layer-rgb16",
     "layer-rgb-float", "layer-rgba-float-linear", "layer-rgb8-feathered-selection",
-    "filter-threshold-rgba8", "filter-posterize-grey16", "filter-unsharp-float",
+    "layer-rgb8-strength", "filter-threshold-rgba8", "filter-posterize-grey16", "filter-unsharp-float",
     "filter-gegl-median-selection", "filter-levels-rgb8", "filter-curves-rgb8",
     "filter-desaturate-rgb8", "filter-gradient-map-rgb8", "filter-color-exchange-rgb8",
     "filter-mono-mixer-rgb8", "filter-bilateral-rgb8", "filter-mean-curvature-rgb8"]
@@ -342,8 +343,9 @@ def check_case(run, name):
             assert np.abs(written - original).max() < 1e-6, f"{name}: GIMP changed the input"
     expected = aarecovery.recover(original.astype(np.float32), filtered.astype(np.float32),
                                   sigma_d=case["args"]["sigma-d"], sigma_e=case["args"]["sigma-e"],
-                                  iterations=case["args"]["iterations"], linear=linear,
-                                  backend="numpy").astype(np.float64)
+                                  iterations=case["args"]["iterations"], linear=linear, backend="numpy",
+                                  strength=None if case["args"].get("auto-strength", True) else case["args"]["strength"],
+                                  ).astype(np.float64)
     if case.get("selection"):
         # The result merges through the selection mask onto what the layer held before; GIMP
         # composites in linear light, as it does for its own filters.
@@ -357,6 +359,10 @@ def check_case(run, name):
     assert recovered.shape == expected.shape, f"{name}: {recovered.shape} vs {expected.shape}"
     error = np.abs(recovered - expected).max()
     assert error <= TOLERANCE, f"{name}: max difference {error * 255:.3f}/255 from aarecovery.recover"
+    # What happened, in the line the status bar shows (and a message, when F was kept).
+    assert result["summary"].startswith(("repaired ", "returned F unchanged")), result
+    if not case["args"].get("auto-strength", True):
+        assert f"strength {case['args']['strength']:g}" in result["summary"], result
     # The test must be able to fail: the recovery changed something the filter had damaged.
     changed = np.abs(recovered - filtered).max()
     if not case.get("selection") and not case.get("smooth"):   # a smooth tone map damages no edge

@@ -308,3 +308,8 @@ def test_plugin_dialog_repeats_the_core_parameters_exactly():
     for (_, _, kind, minimum, maximum, default, blurb), spec in zip(rows, aarecovery.PARAMETERS.values()):
         assert (kind, minimum, maximum, default, blurb) == (spec.kind.__name__, spec.minimum, spec.maximum,
                                                             spec.default, spec.help)
+    # A parameter the safe default chooses has an "automatic" box, with the core's words.
+    automatic = ast.literal_eval(next(node.value for node in tree.body if isinstance(node, ast.Assign) and any(
+        getattr(target, "id", None) == "AUTOMATIC_ARGUMENTS" for target in node.targets)))
+    assert {name: blurb for name, (_, _, blurb) in automatic.items()} == {
+        spec.name.replace("_", "-"): spec.automatic for spec in aarecovery.PARAMETERS.values() if spec.automatic}

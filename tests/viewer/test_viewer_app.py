@@ -335,3 +335,39 @@ def test_missing_extra_message(monkeypatch, capsys):
     assert main(["view"]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "needs the viewer extra" in err and "[viewer]'" in err
+
+
+def click(app, point):
+    press(app, *point)
+    frames(app, 1)
+    release(app, *point)
+    frames(app, 2)
+
+
+def test_strength_box_and_slider_override_the_safe_default(app, image_pair):
+    from aarecovery.viewer.sources import PairSource
+    from aarecovery.viewer.status import plan_line
+
+    assert app.opener.open(PairSource(*image_pair))
+    frames(app, 3)
+    chosen = app.engine.last_plan.strength
+    assert app.recovery.settings.strength is None and "strength" not in app.widget_rects
+    # The summary waits until the result has rested, then the status line gives the share.
+    app.recovery.refresh_summary(app.recovery._computed_at + 2 * app.recovery.SUMMARY_DELAY)
+    assert app.recovery.summary is not None and app.recovery.summary.plan == app.engine.last_plan
+    assert not app.recovery.refresh_summary(), "one summary per result"
+    assert "edge pixels repaired" in plan_line(app.engine, app.recovery.summary).text
+
+    click(app, centre(app.widget_rects["strength auto"]))
+    assert app.recovery.settings.strength == chosen, "unticked, the slider starts at the chosen strength"
+    left, top, right, bottom = app.widget_rects["strength"]
+    drag(app, (left + 0.5 * (right - left), (top + bottom) / 2), (left + 0.2 * (right - left), (top + bottom) / 2))
+    asked = app.recovery.settings.strength
+    assert 0.05 < asked < 0.45
+    assert app.engine.last_plan.strength == pytest.approx(asked) and "as asked" in app.engine.last_plan.reason
+    from aarecovery.viewer.settings import command_line
+    assert "--strength " + str(np.float32(asked)) in command_line(PairSource(*image_pair), app.recovery.settings, "r.png")
+
+    click(app, centre(app.widget_rects["strength auto"]))
+    assert app.recovery.settings.strength is None
+    assert app.engine.last_plan.strength == chosen

@@ -32,6 +32,22 @@ def test_plan_line_names_the_finding_the_strength_and_the_blend_space(plan_line,
     assert line.detail == plan.reason
 
 
+def test_plan_line_gives_the_share_of_edge_pixels_repaired_once_summarized(plan_line, original):
+    filtered = aarecovery.filters.apply("threshold", original)
+    with aarecovery.Engine(backend="numpy") as engine:
+        engine.set_images(original, filtered)
+        engine.compute()
+        summary = aarecovery.summarize_recovery(engine.last_plan, original, filtered, engine.result())
+        line = plan_line(engine, summary)
+        assert 0 < summary.edge_share <= 1
+        assert f", {summary.edge_share:.0%} of edge pixels repaired, full strength" in line.text
+        engine.compute(strength=0.5)
+        # The summary belongs to the previous run: no share until the new one is summarized.
+        asked = plan_line(engine, summary)
+    assert "edge pixels repaired" not in asked.text and "strength 0.5" in asked.text
+    assert asked.detail.endswith("; strength 0.5 as asked instead")
+
+
 def test_plan_line_says_f_is_kept_and_how_to_force_a_repair(plan_line, original):
     with aarecovery.Engine(backend="numpy") as engine:
         engine.set_images(original, aarecovery.filters.apply("blur", original))
@@ -40,5 +56,5 @@ def test_plan_line_says_f_is_kept_and_how_to_force_a_repair(plan_line, original)
         assert engine.last_plan.strength == 0
         engine.compute(mode="paper")
         paper = plan_line(engine)
-    assert kept.text == "safe: F is a low-pass of O, F shown unchanged, switch to paper mode to force a repair"
+    assert kept.text == "safe: F is a low-pass of O, F shown unchanged, untick auto strength to force a repair"
     assert paper.text == "paper: the published method, full strength, blend in linear light"

@@ -1,0 +1,121 @@
+"""The strength control and the one-line summary of what a recovery did (API and commands)."""
+
+import numpy as np
+import pytest
+
+import aarecovery
+from aarecovery.cli import main
+from scenes import disc_and_bar
+from test_cli_recover import edge_pair
+
+
+@pytest.fixture
+def threshold_pair():
+    return edge_pair(dtype=np.uint8)
+
+
+@pytest.fixture
+def blur_pair():
+    # Edges in every direction: a lone straight edge leaves the blur kernel undetermined.
+    original = np.rint(disc_and_bar()[..., :3] * 255).astype(np.uint8)
+    return original, aarecovery.filters.apply("blur", original)
+
+
+def test_strength_scales_the_repair_between_f_and_the_full_repair(threshold_pair, backend):
+    original, filtered = threshold_pair
+    with aarecovery.Engine(backend) as engine:
+        engine.set_images(original, filtered)
+        full = engine.recover(strength=1).astype(np.float64)
+        assert engine.last_plan.strength == 1 and engine.last_plan.reason.endswith("; strength 1 as asked instead")
+        none = engine.recover(strength=0)
+        half = engine.recover(strength=0.5).astype(np.float64)
+    np.testing.assert_array_equal(none, filtered)
+    assert np.abs(full - filtered).max() > 60
+    # Half the strength: about half of the change (the solve is not linear in strength).
+    changed = np.abs(full - filtered) > 8
+    ratio = np.abs(half - filtered)[changed].sum() / np.abs(full - filtered)[changed].sum()
+    assert 0.3 < ratio < 0.7, ratio
+
+
+def test_strength_forces_a_repair_where_the_safe_default_keeps_f(blur_pair, backend):
+    original, filtered = blur_pair
+    kept = aarecovery.recover(original, filtered, backend=backend)
+    np.testing.assert_array_equal(kept, filtered)
+    forced = aarecovery.recover(original, filtered, backend=backend, strength=1)
+    assert np.abs(forced.astype(np.int64) - filtered).max() > 2
+    paper = aarecovery.recover(original, filtered, backend=backend, mode="paper", strength=0.25)
+    paper_full = aarecovery.recover(original, filtered, backend=backend, mode="paper")
+    assert np.abs(paper.astype(np.int64) - filtered).sum() < np.abs(paper_full.astype(np.int64) - filtered).sum()
+
+
+@pytest.mark.parametrize("value", [-0.1, 1.5, float("nan"), "1", True])
+def test_a_strength_outside_0_to_1_is_refused_with_the_way_back(threshold_pair, value):
+    with pytest.raises(aarecovery.InputError, match=r"strength must be a number from 0 to 1, got .*; leave it "
+                                                    r"out for the strength the safe default chooses per image"):
+        aarecovery.recover(*threshold_pair, backend="numpy", strength=value)
+
+
+def test_summary_counts_the_changed_pixels_and_names_the_plan(threshold_pair, backend):
+    original, filtered = threshold_pair
+    with aarecovery.Engine(backend) as engine:
+        recovered = aarecovery.recover(original, filtered, engine=engine)
+        summary = aarecovery.summarize_recovery(engine.last_plan, original, filtered, recovered)
+    changed = (np.abs(recovered.astype(np.int64) - filtered).max(axis=-1) >= 1).sum()
+    assert summary.changed_pixels == changed > 0
+    assert 0.2 < summary.edge_share <= 1
+    plan = summary.plan
+    assert summary.line() == (f"repaired {summary.edge_share:.0%} of the edge pixels ({changed} pixels changed) in "
+                              f"safe mode: strength {plan.strength:g}, blend in {plan.blend_space}"
+                              + (", pure colours of thin features" if plan.pure_colours is not None else ""))
+
+
+def test_summary_of_a_kept_f_says_why_and_how_to_force(blur_pair):
+    original, filtered = blur_pair
+    with aarecovery.Engine("numpy") as engine:
+        recovered = aarecovery.recover(original, filtered, engine=engine)
+        # recover kept F without running the engine, and still left the plan on it.
+        summary = aarecovery.summarize_recovery(engine.last_plan, original, filtered, recovered)
+    assert summary.changed_pixels == 0
+    line = summary.line(force="--strength 1")
+    assert line.startswith("returned F unchanged (safe mode): F is a low-pass (blur) of O")
+    assert line.endswith("; to repair anyway, use --strength 1")
+
+
+def test_summary_of_a_float_grey_pair_counts_in_its_own_scale():
+    original = edge_pair(dtype=np.uint16)[0][..., 0].astype(np.float32) / 65535
+    filtered = (original > 0.5).astype(np.float32)
+    recovered = aarecovery.recover(original, filtered, backend="numpy")
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(original, filtered)
+        plan = engine.plan()
+    summary = aarecovery.summarize_recovery(plan, original, filtered, recovered)
+    assert summary.changed_pixels == (np.abs(recovered - filtered) > 0.5 / 255).sum() > 0
+
+
+def test_recover_prints_the_summary_and_takes_strength(tmp_path, capsys, blur_pair):
+    original, filtered = blur_pair
+    aarecovery.write_image(tmp_path / "o.png", original)
+    aarecovery.write_image(tmp_path / "f.png", filtered)
+    assert main(["recover", str(tmp_path / "o.png"), str(tmp_path / "f.png"), "-o", str(tmp_path / "kept.png"),
+                 "--backend", "numpy"]) == 0
+    wrote, said = capsys.readouterr().out.splitlines()
+    assert wrote.startswith(f"wrote {tmp_path / 'kept.png'}")
+    assert said.startswith("returned F unchanged") and said.endswith("use --strength 1")
+    assert main(["recover", str(tmp_path / "o.png"), str(tmp_path / "f.png"), "-o", str(tmp_path / "forced.png"),
+                 "--backend", "numpy", "--strength", "1"]) == 0
+    said = capsys.readouterr().out.splitlines()[1]
+    assert said.startswith("repaired ") and "strength 1," in said
+    forced = aarecovery.read_image(tmp_path / "forced.png")
+    assert np.abs(forced.astype(np.int64) - filtered).max() > 2
+
+
+def test_filter_recover_prints_the_summary_and_strength_needs_recover(tmp_path, capsys, threshold_pair):
+    aarecovery.write_image(tmp_path / "o.png", threshold_pair[0])
+    assert main(["filter", "threshold", str(tmp_path / "o.png"), "-o", str(tmp_path / "r.png"), "--recover",
+                 "--strength", "0.5", "--backend", "numpy"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == f"wrote {tmp_path / 'r.png'}" and "strength 0.5," in lines[1]
+    assert main(["filter", "threshold", str(tmp_path / "o.png"), "-o", str(tmp_path / "t.png"),
+                 "--strength", "0.5"]) == 1
+    assert "--strength only applies with --recover" in capsys.readouterr().err
+    assert not (tmp_path / "t.png").exists()
