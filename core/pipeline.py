@@ -12,14 +12,15 @@ from .contract import check_same_size, check_values, layout_of
 from .engine import Engine
 from .params import DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, Parameters, check_blend_space, check_mode
 from .plan import make_plan
+from .sample import array_sample
 from .tiling import check_tile_size, halo_for, tiles
 
-__all__ = ["recover"]
+__all__ = ["recover", "recover_tiles"]
 
 
 def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
             backend="auto", linear=False, blend_space=None, return_maps=False, tile_size=None, engine=None,
-            mode=DEFAULT_MODE):
+            mode=DEFAULT_MODE, plan=None):
     """Repair the antialiased edges of `filtered` using the edges of `original`.
 
     Parameters
@@ -55,6 +56,11 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
         blend space, leaves blurred images alone, and calibrates the repair strength so that
         the result is not worse than `filtered` (see ``docs/quality.md``). ``"paper"`` is the
         method of Yang et al. (2011) exactly.
+    plan : Plan, optional
+        The pair's plan when it is already made (``aarecovery.plan.make_plan`` on the
+        window ``aarecovery.sample`` picks, as this function would make it): the batch
+        makes it in a worker thread. It then decides instead of the parameters, `mode`
+        and `blend_space`.
 
     Returns
     -------
@@ -87,8 +93,11 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
         tile_size = check_tile_size(tile_size, parameters.iterations)
     check_values(original, o_layout, "original")
     check_values(filtered, f_layout, "filtered")
-    # Every decision on the whole image, before tiling, so that tiled == untiled.
-    plan = make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space)
+    # Every decision on the whole image, before tiling, so that tiled == untiled; the
+    # analysis reads the window that aarecovery.sample chooses, as a streamed pair does.
+    if plan is None:
+        plan = make_plan(*array_sample(original, filtered), parameters, mode=mode, linear=linear,
+                         blend_space=blend_space)
     if plan.keeps_filtered and not return_maps:
         return filtered.copy()
 
@@ -103,16 +112,50 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
         maps = None
         if return_maps:
             maps = RecoveryMaps(*(np.empty((height, width), np.float32) for _ in RecoveryMaps.NAMES))
-        for inner, outer in tiles(height, width, tile, halo_for(plan.iterations)):
-            engine.set_images(original[outer], filtered[outer], linear=linear, blend_space=plan.blend_space)
-            engine.run(plan, maps=return_maps)
-            crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
-            result[inner] = engine.result()[crop]
+        pieces = recover_tiles(engine, lambda outer: (original[outer], filtered[outer]), plan,
+                               tiles(height, width, tile, halo_for(plan.iterations)), linear=linear, maps=return_maps)
+        for inner, tile_result, tile_maps in pieces:
+            result[inner] = tile_result
             if return_maps:
-                tile_maps = engine.maps()
                 for name in RecoveryMaps.NAMES:
-                    getattr(maps, name)[inner] = getattr(tile_maps, name)[crop]
+                    getattr(maps, name)[inner] = getattr(tile_maps, name)
     finally:
         if own_engine:
             engine.release()
     return (result, maps) if return_maps else result
+
+
+def recover_tiles(engine, read, plan, pieces, *, linear=False, maps=False):
+    """Run a resolved plan tile by tile: the loop of :func:`recover`, for any source of pixels.
+
+    Parameters
+    ----------
+    engine : Engine
+    read : callable
+        ``read(outer) -> (original, filtered)``: the pair's pixels in the rows and columns
+        ``outer`` (a tuple of two slices), in the caller's layout and dtype.
+    plan : Plan
+        Made once for the whole pair.
+    pieces : iterable of (inner, outer)
+        Tiles with halos, from ``aarecovery.tiling.tiles``.
+    linear, maps : bool
+        The pair holds linear light; also give each tile's maps.
+
+    Yields
+    ------
+    inner : tuple of slice
+    result : ndarray
+        R on `inner`, in the filtered image's layout and dtype.
+    maps : RecoveryMaps or None
+        The maps on `inner`, with ``maps=True``.
+    """
+    for inner, outer in pieces:
+        original, filtered = read(outer)
+        engine.set_images(original, filtered, linear=linear, blend_space=plan.blend_space)
+        engine.run(plan, maps=maps)
+        crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
+        tile_maps = None
+        if maps:
+            whole = engine.maps()
+            tile_maps = RecoveryMaps(*(getattr(whole, name)[crop] for name in RecoveryMaps.NAMES))
+        yield inner, engine.result()[crop], tile_maps
