@@ -6,15 +6,11 @@ import sys
 
 # Already imported with the package; the codecs and the engine's backends load in run().
 from ..errors import InputError
+from ..io.maps import MAP_SCALES, map_paths, write_maps
 from ..params import BACKENDS, BLEND_SPACES, PARAMETERS
 from ..tiling import DEFAULT_TILES
 
 __all__ = ["register", "run", "MAP_SCALES"]
-
-#: Factor each map is multiplied by before it is clipped to [0, 1] and stored as 16-bit
-#: grey; ``"sqrt"`` stores the square root, the geometric mean of O's and F's Sobel
-#: magnitudes, which makes the weak edges that sigma_e decides about visible.
-MAP_SCALES = {"alpha": 1.0, "beta": 1.0, "edge_strength": "sqrt", "residual": 10.0}
 
 _DESCRIPTION = """\
 Repair the antialiased edges of FILTERED (the image after a nonlinear filter) using the
@@ -54,6 +50,19 @@ def register(subparsers):
     parser.add_argument("filtered", metavar="FILTERED", help="the same image after the filter, same size")
     parser.add_argument("-o", "--output", metavar="OUTPUT", required=True,
                         help="where to write the result; its folder must exist")
+    add_recovery_options(parser)
+    parser.add_argument("--maps", metavar="DIR",
+                        help="also write alpha, beta, edge_strength and residual maps as 16-bit PNGs "
+                             "into DIR (created if missing); scales below")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="allow OUTPUT to replace ORIGINAL or FILTERED (any other existing file "
+                             "is always replaced)")
+    parser.set_defaults(run=run)
+    return parser
+
+
+def add_recovery_options(parser):
+    """The recovery's options, shared by ``recover`` and ``batch``: parameters, backend, mode, tiles."""
     add_parameter_options(parser)
     parser.add_argument("--backend", choices=BACKENDS, default="auto",
                         help="auto uses OpenGL and falls back to NumPy (default %(default)s)")
@@ -65,18 +74,11 @@ def register(subparsers):
     parser.add_argument("--paper", action="store_true",
                         help="the published method exactly, without the safeguards that keep the "
                              "result from being worse than FILTERED on blurred or textured images")
-    parser.add_argument("--maps", metavar="DIR",
-                        help="also write alpha, beta, edge_strength and residual maps as 16-bit PNGs "
-                             "into DIR (created if missing); scales below")
-    parser.add_argument("--overwrite", action="store_true",
-                        help="allow OUTPUT to replace ORIGINAL or FILTERED (any other existing file "
-                             "is always replaced)")
     parser.add_argument("--tile-size", type=int, metavar="N",
                         help="largest tile side in pixels; larger images are processed in overlapping "
                              f"tiles with the same result (default: {DEFAULT_TILES['gl']} on GL, "
-                             f"{DEFAULT_TILES['numpy']} on NumPy)")
-    parser.set_defaults(run=run)
-    return parser
+                             f"{DEFAULT_TILES['numpy']} on NumPy); tiled TIFFs are streamed in tiles "
+                             "of this size")
 
 
 def add_parameter_options(parser):
@@ -98,24 +100,6 @@ def _refuse_overwriting_inputs(outputs, inputs, allowed):
             if not allowed and _same_file(output, source):
                 raise InputError(f"output {output} is the {role} image {source}; choose another output "
                                  "name, or pass --overwrite to replace it")
-
-
-def _map_paths(folder):
-    return {name: os.path.join(folder, f"{name}.png") for name in MAP_SCALES}
-
-
-def _visible_map(values, scale):
-    import numpy as np
-
-    scaled = np.sqrt(np.maximum(values, 0)) if scale == "sqrt" else values * np.float32(scale)
-    return np.rint(np.clip(scaled, 0, 1) * 65535).astype(np.uint16)
-
-
-def _write_maps(folder, maps):
-    from ..io import write_image
-
-    for name, path in _map_paths(folder).items():
-        write_image(path, _visible_map(getattr(maps, name), MAP_SCALES[name]))
 
 
 def _make_engine(backend):
@@ -150,16 +134,20 @@ def run(args):
     if args.maps is not None:
         if os.path.exists(args.maps) and not os.path.isdir(args.maps):
             raise InputError(f"--maps {args.maps} is a file; give a folder to write the maps into")
-        outputs += _map_paths(args.maps).values()
+        outputs += map_paths(args.maps).values()
     _refuse_overwriting_inputs(outputs, inputs, args.overwrite)
-
-    original = read_image(args.original)
-    filtered = read_image(args.filtered)
-    # Before the recovery, so that a long run does not end in a refusal.
-    check_output_path(args.output, filtered.shape)
 
     engine = _make_engine(args.backend)
     try:
+        pair = None if args.maps is not None else _open_streamed(args, params, engine)
+        if pair is not None:
+            with pair:
+                print(_recover_streamed(args, params, pair, engine))
+            return 0
+        original = read_image(args.original)
+        filtered = read_image(args.filtered)
+        # Before the recovery, so that a long run does not end in a refusal.
+        check_output_path(args.output, filtered.shape)
         start = time.perf_counter()
         result = recover(original, filtered, sigma_d=params.sigma_d, sigma_e=params.sigma_e,
                          iterations=params.iterations, linear=args.linear, blend_space=args.blend_space,
@@ -177,7 +165,31 @@ def run(args):
     message = (f"wrote {args.output} ({result.shape[1]}x{result.shape[0]}, {result.dtype}) "
                f"with the {backend} backend in {seconds:.2f} s")
     if args.maps is not None:
-        _write_maps(args.maps, maps)
+        write_maps(args.maps, maps)
         message += f"; maps in {args.maps}"
     print(message)
     return 0
+
+
+def _open_streamed(args, params, engine):
+    """A pair of TIFFs that can be read in pieces and is larger than a tile, else None."""
+    from ..stream import open_pair, resolve_tile
+
+    return open_pair(args.original, args.filtered, resolve_tile(engine.capabilities, args.tile_size),
+                     params.iterations)
+
+
+def _recover_streamed(args, params, pair, engine):
+    """Recover a pair of TIFFs tile by tile from file to file; return the message."""
+    import time
+
+    from ..io import check_output_path
+    from ..stream import plan_pair, recover_pair
+
+    check_output_path(args.output, pair.result_shape)
+    start = time.perf_counter()
+    plan = plan_pair(pair, params, mode="paper" if args.paper else "safe", linear=args.linear,
+                     blend_space=args.blend_space)
+    recover_pair(pair, args.output, plan, engine=engine, tile=args.tile_size, linear=args.linear)
+    return (f"wrote {args.output} ({pair.width}x{pair.height}, {pair.result_dtype}) with the {engine.backend} "
+            f"backend in {time.perf_counter() - start:.2f} s, streamed in tiles")

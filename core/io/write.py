@@ -9,7 +9,7 @@ from ..contract import check_values, layout_of
 from ..errors import InputError
 from .formats import NPY_DTYPES, WRITE_FORMATS, import_codec, layout_name
 
-__all__ = ["write_image", "check_output_path"]
+__all__ = ["write_image", "check_output_path", "tiff_options"]
 
 _JPEG_QUALITY = 95
 
@@ -83,6 +83,13 @@ def _encoded_pixels(image, format_name):
     return np.rint(image / np.float32(257)).astype(np.uint8)
 
 
+def tiff_options(channels):
+    """How a TIFF of `channels` samples is stored (tifffile's ``write`` keywords), whole or in tiles."""
+    return dict(photometric="rgb" if channels >= 3 else "minisblack",
+                extrasamples=("unassalpha",) if channels in (2, 4) else None,
+                compression="zlib", predictor=True, metadata=None)
+
+
 def _encode(file, pixels, format_name):
     if format_name == "NPY":
         np.save(file, pixels, allow_pickle=False)
@@ -91,11 +98,7 @@ def _encode(file, pixels, format_name):
         file.write(imagecodecs.png_encode(pixels))
     elif format_name == "TIFF":
         tifffile = import_codec("tifffile", "TIFF")
-        channels = 1 if pixels.ndim == 2 else pixels.shape[2]
-        tifffile.imwrite(
-            file, pixels, photometric="rgb" if channels >= 3 else "minisblack",
-            extrasamples=("unassalpha",) if channels in (2, 4) else None,
-            compression="zlib", predictor=True, metadata=None)
+        tifffile.imwrite(file, pixels, **tiff_options(1 if pixels.ndim == 2 else pixels.shape[2]))
     else:
         _encode_with_pillow(file, pixels, format_name)
 
