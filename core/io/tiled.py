@@ -7,10 +7,11 @@ and :class:`TiledTiffWriter` writes a tiled TIFF, BigTIFF when it may pass 4 GB,
 tile, atomically. PNG, JPEG and the other formats have no such segments (a PNG is one
 compressed stream) and are read whole by :func:`aarecovery.read_image`.
 
-Decoding the segments here, not through ``tifffile.imread(selection=...)``: that builds a
-Zarr array per call (the ``zarr`` package, and a reopened file per region); measured on a
-20000 x 20000 RGB file in 256 x 256 zlib tiles, reading 2048 x 2048 regions took 0.21 s
-each here against 0.25 s through Zarr, with no extra dependency.
+Decoding the segments here, not through ``tifffile.imread(selection=...)``: that needs the
+``zarr`` package and reopens the file and builds a Zarr array per call. Measured on a
+20000 x 20000 RGB file in 512 x 512 zstd tiles, 1032 x 1032 regions (a streamed tile with
+its halo) at nine places, no segment cached: 0.033 s each here, 0.068 s through Zarr, the
+same pixels.
 """
 
 import os
