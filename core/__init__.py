@@ -16,11 +16,12 @@ __version__ = "0.1.0"
 
 from . import filters
 from .backends.base import RecoveryMaps
+from .batch import recover_many
 from .engine import Engine
 from .errors import InputError
 from .io import read_image, write_image
 from .params import BACKENDS, BLEND_SPACES, MODES, PARAMETERS
 from .pipeline import recover
 
-__all__ = ["recover", "Engine", "RecoveryMaps", "InputError", "read_image", "write_image", "filters",
+__all__ = ["recover", "recover_many", "Engine", "RecoveryMaps", "InputError", "read_image", "write_image", "filters",
            "PARAMETERS", "BACKENDS", "MODES", "BLEND_SPACES", "__version__"]

@@ -5,14 +5,14 @@
 #
 # As root it installs the Debian packages the tests drive for real (Mesa's EGL/llvmpipe for
 # the GL backend, Xvfb for the viewer window, gegl and gmic for the eval's peer tools,
-# debootstrap for the GIMP 3 sandbox) and builds or refreshes the GIMP 3 sandbox (a Debian
+# imagemagick and gmic for the batch's filter commands, debootstrap for the GIMP 3 sandbox) and builds or refreshes the GIMP 3 sandbox (a Debian
 # trixie root, cached outside the checkout). Without root it installs nothing system-wide and
 # says loudly what is missing; the tests that need it then fail in CI or skip with a message.
 # The Python side always goes into .venv in the checkout.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-DEBIAN_PACKAGES=(libegl1 libgl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth gegl gmic debootstrap)
+DEBIAN_PACKAGES=(libegl1 libgl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth gegl gmic imagemagick debootstrap)
 
 missing=()
 for package in "${DEBIAN_PACKAGES[@]}"; do
