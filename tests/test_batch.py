@@ -42,6 +42,18 @@ def write_pairs(folder, names):
     return pairs
 
 
+def write_numbered_pairs(folder, count, size):
+    """`count` noisy pairs image00.png... under folder/o and folder/f; returns {name: (O, F)}."""
+    pairs = {}
+    for index in range(count):
+        original = shapes(size, seed=index, noise=0.02)
+        pairs[f"image{index:02d}.png"] = (original, threshold(original))
+        for sub, image in zip("of", pairs[f"image{index:02d}.png"]):
+            os.makedirs(folder / sub, exist_ok=True)
+            write_image(folder / sub / f"image{index:02d}.png", image)
+    return pairs
+
+
 def corrupt(path):
     """A file that starts like a PNG and stops."""
     os.makedirs(os.path.dirname(path), exist_ok=True)
@@ -189,14 +201,8 @@ def _interrupt_after_first_results(tmp_path, signal_number):
 
 @pytest.mark.parametrize("signal_number", [signal.SIGINT, signal.SIGKILL])
 def test_an_interrupted_batch_leaves_only_complete_results_and_resumes(tmp_path, signal_number):
-    names = [f"image{index:02d}.png" for index in range(8)]
-    pairs = {}
-    for index, name in enumerate(names):
-        original = shapes(96, seed=index, noise=0.02)
-        pairs[name] = (original, threshold(original))
-        for sub, image in zip("of", pairs[name]):
-            os.makedirs(tmp_path / sub, exist_ok=True)
-            write_image(tmp_path / sub / name, image)
+    pairs = write_numbered_pairs(tmp_path, 8, 96)
+    names = sorted(pairs)
     status, out, err = _interrupt_after_first_results(tmp_path, signal_number)
     written = results(tmp_path / "r")
     assert 2 <= len(written) < len(names), (status, out, err)

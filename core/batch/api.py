@@ -9,6 +9,7 @@ from ..errors import InputError
 from ..params import DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, Parameters, check_backend, check_blend_space, \
     check_mode
 from ..tiling import check_tile_size
+from . import storage
 from .filtering import BuiltinFilter, FilterCommand
 from .jobs import Job, output_name
 from .local import run_local
@@ -85,6 +86,10 @@ def make_settings(*, output=None, filter=None, filter_params=None, filter_comman
     for role, folder in (("output", output), ("keep_filtered", keep_filtered), ("maps", maps)):
         if folder is not None and os.path.exists(folder) and not os.path.isdir(folder):
             raise InputError(f"{role} {folder} is a file; give a folder")
+    for role, folder in (("keep_filtered", keep_filtered), ("maps", maps)):
+        if storage.is_url(folder):
+            raise InputError(f"{role} {folder} is a URL; {role} must be a local folder (only the images and the "
+                             "results may be URLs)")
     if output is None and (keep_filtered is not None or maps is not None):
         raise InputError("keep_filtered and maps need an output folder; give output=")
     return Settings(parameters=parameters, mode=mode, linear=bool(linear), blend_space=blend_space, backend=backend,

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 from ..errors import InputError
 from ..io.formats import WRITE_FORMATS
+from . import storage
 
 __all__ = ["Job", "IMAGE_EXTENSIONS", "find_pairs", "find_images", "output_name"]
 
@@ -48,13 +49,19 @@ def _relative(path, root):
     return os.path.relpath(path, root).replace(os.sep, "/")
 
 
+def _is_image(name):
+    return not name.rsplit("/", 1)[-1].startswith(".") and os.path.splitext(name)[1].lower() in IMAGE_EXTENSIONS
+
+
 def _folder_images(folder):
+    if storage.is_url(folder):
+        return {name: url for name, url in sorted(storage.listing(folder).items()) if _is_image(name)}
     found = {}
     for directory, subfolders, files in os.walk(folder):
         subfolders[:] = sorted(name for name in subfolders if not name.startswith("."))
         for name in sorted(files):
             # Hidden files include the temporary files of interrupted writes (".name.XXXX.part.png").
-            if not name.startswith(".") and os.path.splitext(name)[1].lower() in IMAGE_EXTENSIONS:
+            if _is_image(name):
                 path = os.path.join(directory, name)
                 found[_relative(path, folder)] = path
     return found
@@ -102,17 +109,23 @@ def _glob_images(pattern):
     """``{key: (relative name, path)}``: the key is what the wildcards matched."""
     root = _glob_root(pattern)
     regex = _wildcard_regex(pattern.replace(os.sep, "/"))
+    if storage.is_url(pattern):
+        paths = sorted(storage.listing(pattern).values())
+    else:
+        paths = [path for path in sorted(glob.glob(pattern, recursive=True)) if os.path.isfile(path)]
     found = {}
-    for path in sorted(glob.glob(pattern, recursive=True)):
-        if os.path.isfile(path) and os.path.splitext(path)[1].lower() in IMAGE_EXTENSIONS:
+    for path in paths:
+        if _is_image(path.replace(os.sep, "/")):
             match = regex.match(path.replace(os.sep, "/"))
             key = match.groups() if match else (path,)
-            found[key] = (_relative(path, root), path)
+            name = path[len(root):].lstrip("/") if storage.is_url(path) else _relative(path, root)
+            found[key] = (name, path)
     return found
 
 
 def find_images(source):
-    """The images of a folder (recursively, hidden files skipped) or of a glob.
+    """The images of a folder (recursively, hidden files skipped) or of a glob; either may be
+    an fsspec URL (``s3://bucket/scans/``).
 
     Returns
     -------
@@ -130,7 +143,7 @@ def find_images(source):
             raise InputError(f"no image files match {source!r}; check the pattern (quote it so that the shell "
                              f"does not expand it) and the extensions ({', '.join(IMAGE_EXTENSIONS)})")
         return found
-    if not os.path.isdir(source):
+    if not storage.is_url(source) and not os.path.isdir(source):
         raise InputError(f"{source} is not a folder or a glob pattern; give a folder of images or a pattern "
                          "such as 'scans/*.png'")
     found = sorted(_folder_images(source).items())
@@ -171,7 +184,7 @@ def find_pairs(originals, filtered):
                 unmatched.append(path)
         return jobs, unmatched
     left = dict(find_images(originals))
-    if not os.path.isdir(filtered):
+    if not storage.is_url(filtered) and not os.path.isdir(filtered):
         raise InputError(f"{filtered} is not a folder; give the folder that holds the filtered images")
     right = _folder_images(filtered)
     by_stem = {}

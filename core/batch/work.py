@@ -25,10 +25,11 @@ from ..params import Parameters
 from ..pipeline import recover
 from ..plan import make_plan
 from ..sample import array_sample
+from . import storage
 from .filtering import BuiltinFilter, FilterCommand
 from .jobs import output_name
 
-__all__ = ["Settings", "ImageResult", "Work", "prepare", "compute", "store", "run_one", "REPORT_FIELDS"]
+__all__ = ["Settings", "ImageResult", "Work", "prepare", "compute", "store", "run_one", "fail", "REPORT_FIELDS"]
 
 
 @dataclass(frozen=True)
@@ -136,11 +137,13 @@ class Work:
     job: object
     result: ImageResult
     output: str = None
+    target: str = None
     original: object = None
     filtered: object = None
     filtered_file: str = None
     pair: object = None
     plan: object = None
+    capabilities: object = None
     recovered: object = None
     maps: object = None
     scratch: str = None
@@ -156,7 +159,21 @@ class Work:
         self.original = self.filtered = self.recovered = self.maps = None
 
 
-def _fail(work, error):
+def _scratch(work):
+    """The image's private temporary folder (removed when it is finished)."""
+    if work.scratch is None:
+        work.scratch = tempfile.mkdtemp(prefix="aarecovery-batch-")
+    return work.scratch
+
+
+def _local(work, path):
+    """A local file for an input: the path itself, or a copy of a URL in the scratch folder."""
+    path = os.fspath(path)
+    return storage.fetch(path, _scratch(work)) if storage.is_url(path) else path
+
+
+def fail(work, error):
+    """Mark `work` failed with `error` (one line; an unexpected error says so) and finish it."""
     work.result.status = "failed"
     work.result.error = str(error) if isinstance(error, (InputError, OSError)) else \
         f"{type(error).__name__}: {error} (an internal error; please report it)"
@@ -191,15 +208,17 @@ def _same_file(first, second):
 
 def _up_to_date(output, inputs):
     """The result exists (so it is complete: every write is atomic) and is newer than its inputs."""
-    try:
-        made = os.stat(output).st_mtime_ns
-        return all(os.stat(path).st_mtime_ns <= made for path in inputs)
-    except OSError:
+    made = storage.modified(output)
+    if made is None:
         return False
+    stamps = [storage.modified(path) for path in inputs]
+    return all(stamp is not None and stamp <= made for stamp in stamps)
 
 
 def remove_stale_parts(output, before):
     """Remove temporary files of `output` that an interrupted run left (older than `before`, a time)."""
+    if storage.is_url(output):
+        return
     folder, name = os.path.split(os.path.abspath(output))
     stem, extension = os.path.splitext(name)
     for path in glob.glob(os.path.join(glob.escape(folder), f".{glob.escape(stem)}.*.part{glob.escape(extension)}")):
@@ -232,7 +251,7 @@ def prepare(job, settings, capabilities, started):
         with _Timed(work.result):
             _prepare(work, settings, capabilities, started)
     except Exception as error:
-        return _fail(work, error)
+        return fail(work, error)
     return work
 
 
@@ -240,25 +259,28 @@ def _prepare(work, settings, capabilities, started):
     job, result = work.job, work.result
     if job.filtered is None and settings.filter is None:
         raise InputError(f"{job.name}: no filtered image and no filter to make one")
-    inputs = [path for path in (job.original, job.filtered) if _is_path(path)]
+    inputs = [os.fspath(path) for path in (job.original, job.filtered) if _is_path(path)]
     if settings.output is not None:
-        work.output = os.path.join(settings.output, *output_name(job.name, settings.format).split("/"))
+        work.output = work.target = storage.join(settings.output, output_name(job.name, settings.format))
         for role, path in zip(("original", "filtered"), (job.original, job.filtered)):
-            if _is_path(path) and not settings.overwrite and _same_file(work.output, path):
+            if _is_path(path) and not settings.overwrite and not storage.is_url(path) and \
+                    not storage.is_url(work.output) and _same_file(work.output, path):
                 raise InputError(f"the result {work.output} would replace the {role} image; choose another "
                                  "output folder, or pass --overwrite")
         remove_stale_parts(work.output, started)
         if not settings.force and inputs and _up_to_date(work.output, inputs):
             result.status, result.output = "skipped", work.output
             return
-        os.makedirs(os.path.dirname(os.path.abspath(work.output)), exist_ok=True)
-    original_path = job.original if _is_path(job.original) else None
-    filtered_path = job.filtered if _is_path(job.filtered) else None
+        if storage.is_url(work.output):
+            work.target = os.path.join(_scratch(work), "result" + os.path.splitext(work.output)[1])
+        else:
+            os.makedirs(os.path.dirname(os.path.abspath(work.output)), exist_ok=True)
+    original_path, filtered_path = (_local(work, path) if _is_path(path) else None
+                                    for path in (job.original, job.filtered))
     if isinstance(settings.filter, FilterCommand) and job.filtered is None:
         if original_path is None:
             raise InputError(f"{job.name}: a filter command needs the original as a file, not an array")
-        work.scratch = tempfile.mkdtemp(prefix="aarecovery-filter-")
-        filtered_path = work.filtered_file = settings.filter.run(original_path, work.scratch)
+        filtered_path = work.filtered_file = settings.filter.run(original_path, _scratch(work))
     streamable = (work.output is not None and settings.maps is None and original_path and filtered_path
                   and not (isinstance(settings.filter, BuiltinFilter) and job.filtered is None))
     if streamable:
@@ -269,7 +291,7 @@ def _prepare(work, settings, capabilities, started):
         result.streamed = True
         result.height, result.width = work.pair.height, work.pair.width
         result.dtype = str(work.pair.result_dtype)
-        check_output_path(work.output, work.pair.result_shape)
+        check_output_path(work.target, work.pair.result_shape)
         work.plan = stream.plan_pair(work.pair, settings.parameters, mode=settings.mode, linear=settings.linear,
                                      blend_space=settings.blend_space)
     else:
@@ -286,7 +308,7 @@ def _prepare(work, settings, capabilities, started):
         check_values(filtered, f_layout, "filtered")
         result.height, result.width, result.dtype = f_layout.height, f_layout.width, str(f_layout.dtype)
         if work.output is not None:
-            check_output_path(work.output, f_layout.shape)
+            check_output_path(work.target, f_layout.shape)
         work.original, work.filtered = original, filtered
         work.plan = make_plan(*array_sample(original, filtered), settings.parameters, mode=settings.mode,
                               linear=settings.linear, blend_space=settings.blend_space)
@@ -303,7 +325,7 @@ def compute(work, engine, settings):
     try:
         with _Timed(work.result, "recover_seconds"):
             if work.pair is not None:
-                stream.recover_pair(work.pair, work.output, work.plan, engine=engine, tile=settings.tile_size,
+                stream.recover_pair(work.pair, work.target, work.plan, engine=engine, tile=settings.tile_size,
                                     linear=settings.linear)
             else:
                 recovered = recover(work.original, work.filtered, plan=work.plan, engine=engine,
@@ -313,7 +335,7 @@ def compute(work, engine, settings):
                     recovered, work.maps = recovered
                 work.recovered = recovered
     except Exception as error:
-        return _fail(work, error)
+        return fail(work, error)
     return work
 
 
@@ -326,9 +348,11 @@ def store(work, settings):
     try:
         with _Timed(result):
             if work.output is not None and work.pair is None:
-                write_image(work.output, work.recovered)
+                write_image(work.target, work.recovered)
             elif work.output is None:
                 result.image = work.recovered
+            if work.target != work.output:
+                storage.publish(work.target, work.output)
             _keep_filtered(work, settings)
             if settings.maps is not None and work.maps is not None:
                 folder = _kept_path(settings.maps, work.job.name, "")
@@ -337,7 +361,7 @@ def store(work, settings):
         result.output = work.output
         result.status = "done"
     except Exception as error:
-        _fail(work, error)
+        fail(work, error)
         return result
     work.finished()
     return result

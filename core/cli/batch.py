@@ -129,6 +129,7 @@ def run(args):
     """Run ``aarecovery batch`` with parsed arguments; return the exit status."""
     from ..backends import GLUnavailable
     from ..batch import ImageResult, check_report_path, make_settings, run_jobs, summary, write_report
+    from ..batch.storage import is_url
 
     if args.workers is not None and args.workers < 1:
         raise InputError(f"--workers must be at least 1, got {args.workers}")
@@ -145,7 +146,7 @@ def run(args):
     jobs, unmatched = _jobs(args, settings.filter is not None)
     missing = [ImageResult(os.path.relpath(path, args.originals) if os.path.isdir(args.originals) else path,
                            status="failed", error=f"no filtered image matches {path}") for path in unmatched]
-    if not args.dask:
+    if not args.dask and not is_url(args.output):
         os.makedirs(args.output, exist_ok=True)
     engine = None
     if jobs and not args.dask:
