@@ -304,3 +304,16 @@ def test_names_that_collide_are_refused():
     image = np.zeros((8, 8), np.uint8)
     with pytest.raises(aarecovery.InputError, match="both named 'x.png'"):
         aarecovery.recover_many([(image, image, "x.png"), (image, image, "x.png")], backend="numpy")
+
+
+def test_fsspec_urls_for_inputs_and_results(tmp_path, capsys):
+    pytest.importorskip("fsspec", reason="pip install '.[test]' installs fsspec")
+    pairs = write_pairs(tmp_path, ["a.png", "sub/b.tif"])
+    url = f"file://{tmp_path.as_posix()}"
+    status, out, err = run_batch(capsys, f"{url}/o", f"{url}/f", "-o", f"{url}/r", "--backend", "numpy")
+    assert status == 0, err
+    for name, (original, filtered) in pairs.items():
+        assert_equals_recover(tmp_path / "r" / name, original, filtered, backend="numpy")
+    assert no_temporary_files(tmp_path) == []
+    status, out, err = run_batch(capsys, f"{url}/o/*.png", f"{url}/f/*.png", "-o", f"{url}/r", "--backend", "numpy")
+    assert status == 0 and "1 up to date" in out, err
