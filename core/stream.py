@@ -126,10 +126,14 @@ def open_pair(original_path, filtered_path, tile, iterations):
         raise
 
 
-def plan_pair(pair, parameters, *, mode, linear=False, blend_space=None):
-    """The pair's Plan, made once before tiling from the window ``aarecovery.sample`` picks."""
+def plan_pair(pair, parameters, *, mode, linear=False, blend_space=None, planner=make_plan):
+    """The pair's Plan, made once before tiling from the window ``aarecovery.sample`` picks.
+
+    `planner` is ``aarecovery.plan.make_plan`` or a stand-in that runs it elsewhere (the
+    batch runs it in worker processes).
+    """
     sample = analysis_sample(pair.original.read, pair.filtered.read, pair.height, pair.width)
-    return make_plan(*sample, parameters, mode=mode, linear=linear, blend_space=blend_space)
+    return planner(*sample, parameters, mode=mode, linear=linear, blend_space=blend_space)
 
 
 def _read_ahead(items, read):

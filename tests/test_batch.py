@@ -188,13 +188,18 @@ def _batch_command(tmp_path, *extra):
 
 
 def _interrupt_after_first_results(tmp_path, signal_number):
-    process = subprocess.Popen(_batch_command(tmp_path), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    # A session of its own, so that SIGINT reaches the whole process group, as Ctrl+C does.
+    process = subprocess.Popen(_batch_command(tmp_path), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               start_new_session=True)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and process.poll() is None:
         if len(results(tmp_path / "r")) >= 2:
             break
         time.sleep(0.02)
-    process.send_signal(signal_number)
+    if signal_number == signal.SIGINT:
+        os.killpg(process.pid, signal.SIGINT)
+    else:
+        process.send_signal(signal_number)
     out, err = process.communicate(timeout=120)
     return process.returncode, out.decode(), err.decode()
 

@@ -1,17 +1,20 @@
-"""A batch on this machine: one engine for every image, worker threads around it.
+"""A batch on this machine: one engine for every image, workers around it.
 
 The engine (one GL context, its programs compiled once) lives in the calling thread and
-only recovers; worker threads decode, run the filter, make each plan (the safe analysis
-is NumPy) and encode, so that the next images are read and analysed and the last ones
-written while the engine works. At most ``workers + 1`` images wait on either side of the
-engine, which bounds the memory to a few images, not the batch.
+only recovers; worker threads decode, run the filter and encode, so that the next images
+are read and the last ones written while the engine works, and the safe plan's analysis
+runs in worker processes (:mod:`.planner`). At most ``workers + 1`` images wait on either
+side of the engine, which bounds the memory to a few images, not the batch.
 """
 
+import contextlib
 import os
 import time
 from collections import deque
 from concurrent.futures import ThreadPoolExecutor
 
+from ..plan import make_plan
+from .planner import PlannerProcesses
 from .work import compute, prepare, store
 
 __all__ = ["run_local", "default_workers"]
@@ -49,7 +52,10 @@ def run_local(jobs, settings, engine, *, workers=None, progress=None, started=No
     capabilities = engine.capabilities
     results = [None] * len(jobs)
     waiting = deque(enumerate(jobs))
-    with ThreadPoolExecutor(workers, thread_name_prefix="aarecovery-batch") as pool:
+    processes = PlannerProcesses(workers) if settings.mode == "safe" and len(jobs) > 1 else None
+    planner = processes or make_plan
+    threads = ThreadPoolExecutor(workers, thread_name_prefix="aarecovery-batch")
+    with processes or contextlib.nullcontext(), threads as pool:
         prepared, storing = deque(), deque()
 
         def finish(index, future, _work):
@@ -61,7 +67,7 @@ def run_local(jobs, settings, engine, *, workers=None, progress=None, started=No
             while waiting or prepared:
                 while waiting and len(prepared) <= workers:
                     index, job = waiting.popleft()
-                    prepared.append((index, pool.submit(prepare, job, settings, capabilities, started)))
+                    prepared.append((index, pool.submit(prepare, job, settings, capabilities, started, planner)))
                 index, future = prepared.popleft()
                 work = compute(future.result(), engine, settings)
                 storing.append((index, pool.submit(store, work, settings), work))
@@ -89,3 +95,4 @@ def _discard(future):
     except BaseException:
         return
     work.finished()
+

@@ -234,7 +234,7 @@ def _kept_path(folder, name, extension=None):
     return os.path.join(folder, *(stem + (extension or own)).split("/"))
 
 
-def prepare(job, settings, capabilities, started):
+def prepare(job, settings, capabilities, started, planner=make_plan):
     """Stage 1: skip, read, filter, plan. Returns a :class:`Work`, failed or skipped ones included.
 
     Parameters
@@ -245,17 +245,19 @@ def prepare(job, settings, capabilities, started):
         The engine's (which pairs stream).
     started : float
         When the batch started (``time.time()``), for clearing stale temporary files.
+    planner : callable
+        ``aarecovery.plan.make_plan``, or a stand-in that runs it in another process.
     """
     work = Work(job, ImageResult(job.name))
     try:
         with _Timed(work.result):
-            _prepare(work, settings, capabilities, started)
+            _prepare(work, settings, capabilities, started, planner)
     except Exception as error:
         return fail(work, error)
     return work
 
 
-def _prepare(work, settings, capabilities, started):
+def _prepare(work, settings, capabilities, started, planner):
     job, result = work.job, work.result
     if job.filtered is None and settings.filter is None:
         raise InputError(f"{job.name}: no filtered image and no filter to make one")
@@ -293,7 +295,7 @@ def _prepare(work, settings, capabilities, started):
         result.dtype = str(work.pair.result_dtype)
         check_output_path(work.target, work.pair.result_shape)
         work.plan = stream.plan_pair(work.pair, settings.parameters, mode=settings.mode, linear=settings.linear,
-                                     blend_space=settings.blend_space)
+                                     blend_space=settings.blend_space, planner=planner)
     else:
         original = read_image(original_path) if original_path else job.original
         if filtered_path:
@@ -310,8 +312,8 @@ def _prepare(work, settings, capabilities, started):
         if work.output is not None:
             check_output_path(work.target, f_layout.shape)
         work.original, work.filtered = original, filtered
-        work.plan = make_plan(*array_sample(original, filtered), settings.parameters, mode=settings.mode,
-                              linear=settings.linear, blend_space=settings.blend_space)
+        work.plan = planner(*array_sample(original, filtered), settings.parameters, mode=settings.mode,
+                            linear=settings.linear, blend_space=settings.blend_space)
     plan = work.plan
     result.mode, result.blend_space, result.strength, result.reason = (plan.mode, plan.blend_space, plan.strength,
                                                                       plan.reason)

@@ -95,7 +95,8 @@ def _encode(file, pixels, format_name):
         np.save(file, pixels, allow_pickle=False)
     elif format_name == "PNG":
         imagecodecs = import_codec("imagecodecs", "PNG")
-        file.write(imagecodecs.png_encode(pixels))
+        # libpng takes rows of contiguous pixels; a flipped or strided view is copied first.
+        file.write(imagecodecs.png_encode(np.ascontiguousarray(pixels)))
     elif format_name == "TIFF":
         tifffile = import_codec("tifffile", "TIFF")
         tifffile.imwrite(file, pixels, **tiff_options(1 if pixels.ndim == 2 else pixels.shape[2]))
