@@ -138,8 +138,8 @@ def recover_many(pairs, output=None, *, filter=None, filter_params=None, filter_
     force, overwrite : bool
         Redo up-to-date results; allow a result to replace one of its inputs.
     workers : int, optional
-        Worker threads for reading, filtering, planning and writing (default: a measured
-        rule, ``aarecovery.batch.default_workers``).
+        Processes for the safe analysis, and one more thread for reading, filtering and
+        writing (default: a measured rule, ``aarecovery.batch.default_workers``).
     progress : callable, optional
         ``progress(result, done, total)`` after each image (the command line's bar).
     dask : str or distributed.Client, optional

@@ -21,11 +21,23 @@ __all__ = ["run_local", "default_workers"]
 
 
 def default_workers(cores=None):
-    """Worker threads for a batch on a machine with `cores` cores (default: this one's).
+    """Workers for a batch on a machine with `cores` cores (default: this one's): one per
+    core. A worker is an analysis process; one more thread than workers reads, filters and
+    writes, so that a thread waiting for a plan blocks no write.
 
-    Measured with ``aarecovery bench --batch`` (docs/performance.md) on 2 shared cores, 24
-    pairs of 1920 x 1080 PNGs, GL on llvmpipe, safe mode: see the table there. Threads beyond
-    the cores only add contention.
+    Measured with ``aarecovery bench --batch 100`` (1920 x 1080 PNG pairs, thresholded, safe
+    mode, GL on llvmpipe) on 2 cores, images per second for 1 / 2 / 3 / 4 workers, against
+    separate ``aarecovery recover`` calls in the same run of the command:
+
+    * machine nearly idle at the start (load 0 rising to 5 as other jobs began):
+      1.73 / 2.01 / 2.14 / 2.33, separate calls 0.99;
+    * machine shared with other jobs (load 4 to 7): 1.38 / 1.18 / 1.00 / 1.08, separate
+      0.63; and 1.15 / 0.91 / 0.96 / 1.01, separate 0.57.
+
+    The analysis processes are the bottleneck when the cores are ours: one per core. More
+    only won a larger share of cores that other jobs were taking (their load rose during
+    those runs), and when other jobs hold the cores, fewer workers leave the engine (which
+    renders on the CPU with llvmpipe) more of them; ``--workers`` overrides the rule.
     """
     cores = cores or os.cpu_count() or 1
     return max(1, cores)
@@ -41,7 +53,8 @@ def run_local(jobs, settings, engine, *, workers=None, progress=None, started=No
     engine : Engine
         Used in this thread only.
     workers : int, optional
-        Worker threads (default :func:`default_workers`).
+        Analysis processes, and one thread more for reading, filtering and writing (default
+        :func:`default_workers`).
     progress : callable, optional
         ``progress(result)`` after each image, in the order they finish.
     started : float, optional
@@ -54,7 +67,7 @@ def run_local(jobs, settings, engine, *, workers=None, progress=None, started=No
     waiting = deque(enumerate(jobs))
     processes = PlannerProcesses(workers) if settings.mode == "safe" and len(jobs) > 1 else None
     planner = processes or make_plan
-    threads = ThreadPoolExecutor(workers, thread_name_prefix="aarecovery-batch")
+    threads = ThreadPoolExecutor(workers + 1, thread_name_prefix="aarecovery-batch")
     with processes or contextlib.nullcontext(), threads as pool:
         prepared, storing = deque(), deque()
 

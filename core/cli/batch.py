@@ -72,8 +72,8 @@ def register(subparsers):
                         help="write per image the time, size, plan (mode, blend space, strength, reason) and "
                              "backend to FILE (.csv or .json)")
     parser.add_argument("--workers", type=int, metavar="N",
-                        help="threads that read, filter, plan and write around the engine (default: a measured "
-                             "rule for this machine's cores)")
+                        help="analysis processes beside the engine, and N + 1 threads that read, filter and "
+                             "write (default: a measured rule, one per core of this machine)")
     parser.add_argument("--dask", metavar="ADDRESS",
                         help="run on a Dask cluster: a scheduler address (tcp://host:8786) or 'local'; paths must "
                              "be on storage every worker sees (needs pip install 'aarecovery[dask]')")
@@ -102,6 +102,10 @@ def _filter_options(args):
     from .filters import parse_params
 
     spec = filters.get_filter(args.filter[0])
+    for word in args.filter[1:]:
+        if "=" not in word:
+            raise InputError(f"--filter {' '.join(args.filter)}: {word!r} is not PARAM=VALUE; --filter takes the "
+                             "words up to the next option, so put it after ORIGINALS")
     return {"filter": spec.name, "filter_params": parse_params(args.filter[1:], spec)}
 
 
