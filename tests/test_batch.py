@@ -322,3 +322,11 @@ def test_fsspec_urls_for_inputs_and_results(tmp_path, capsys):
     assert no_temporary_files(tmp_path) == []
     status, out, err = run_batch(capsys, f"{url}/o/*.png", f"{url}/f/*.png", "-o", f"{url}/r", "--backend", "numpy")
     assert status == 0 and "1 up to date" in out, err
+
+
+def test_a_filter_command_that_runs_too_long_is_stopped_and_reported(tmp_path, capsys):
+    write_pairs(tmp_path, ["a.png"])
+    status, out, err = run_batch(capsys, tmp_path / "o", "-o", tmp_path / "r", "--backend", "numpy",
+                                 "--filter-cmd", "sh -c 'sleep 30' {in} {out}", "--filter-timeout", "0.5")
+    assert status == 1 and "did not finish within 0.5 s" in err
+    assert not (tmp_path / "r" / "a.png").exists() and no_temporary_files(tmp_path) == []
