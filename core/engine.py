@@ -8,6 +8,7 @@ from .contract import check_same_size, from_rgba_float, layout_of
 from .errors import InputError
 from .params import DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, STRENGTH, Parameters, check_blend_space
 from .plan import analyse_pair, make_plan
+from .sample import array_sample
 
 __all__ = ["Engine", "RecoveryMaps"]
 
@@ -149,7 +150,7 @@ class Engine:
         original, _, filtered, _, linear, blend_space = self._pair
         parameters = Parameters(sigma_d, sigma_e, iterations, strength)
         if mode == "safe" and self._analysis is None:
-            self._analysis = analyse_pair(original, filtered, linear)
+            self._analysis = analyse_pair(*array_sample(original, filtered), linear)
         return make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space,
                          analysis=self._analysis)
 

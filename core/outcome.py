@@ -11,8 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .contract import layout_of, to_rgba_float
-from .plan.analysis import analysis_crop
 from .plan.calibration import EDGE_GRADIENT
+from .sample import analysis_window
 from .spec.sobel import gradient_magnitude
 
 __all__ = ["RecoverySummary", "summarize_recovery"]
@@ -31,12 +31,13 @@ class RecoverySummary:
     ----------
     plan : Plan
         Mode, blend space, strength, pure colours, and the reason.
-    changed_pixels : int
-        Pixels of the whole image where R differs from F by more than half an 8-bit step.
-    edge_share : float
+    changed_pixels : int or None
+        Pixels of the whole image where R differs from F by more than half an 8-bit step
+        (None when not counted: a pair streamed from file to file is never whole in memory).
+    edge_share : float or None
         The share of O's edge pixels (a Sobel / 8 of 0.02 or more) where R differs from F,
-        measured on the central crop of at most 512 x 512 pixels that the safe default
-        analyses (0 when the crop has no edge).
+        measured on the window of at most 512 x 512 pixels that the safe default analyses
+        (0 when it has no edge; None when not measured).
     """
 
     plan: object
@@ -50,8 +51,9 @@ class RecoverySummary:
         if plan.keeps_filtered:
             return f"returned F unchanged ({plan.mode} mode): {plan.reason}; to repair anyway, use {force}"
         pure = ", pure colours of thin features" if plan.pure_colours is not None else ""
-        return (f"repaired {self.edge_share:.0%} of the edge pixels ({self.changed_pixels} pixels changed) in "
-                f"{plan.mode} mode: strength {plan.strength:g}, blend in {plan.blend_space}{pure}")
+        what = ("repaired the edges" if self.edge_share is None else
+                f"repaired {self.edge_share:.0%} of the edge pixels ({self.changed_pixels} pixels changed)")
+        return f"{what} in {plan.mode} mode: strength {plan.strength:g}, blend in {plan.blend_space}{pure}"
 
 
 def _changed(filtered, recovered):
@@ -82,8 +84,9 @@ def summarize_recovery(plan, original, filtered, recovered):
     f_layout = layout_of(filtered, "filtered")
     changed = sum(int(_changed(filtered[top:top + _STRIP_ROWS], recovered[top:top + _STRIP_ROWS]).sum())
                   for top in range(0, f_layout.height, _STRIP_ROWS))
-    o_crop = analysis_crop(original)
-    edges = gradient_magnitude(to_rgba_float(o_crop, layout_of(o_crop, "original"), "original")[..., :3])
+    window = analysis_window(lambda rows, cols: original[rows, cols], f_layout.height, f_layout.width)
+    o_window = original[window]
+    edges = gradient_magnitude(to_rgba_float(o_window, layout_of(o_window, "original"), "original")[..., :3])
     edges = edges >= EDGE_GRADIENT
-    share = float(_changed(analysis_crop(filtered), analysis_crop(recovered))[edges].mean()) if edges.any() else 0.0
+    share = float(_changed(filtered[window], recovered[window])[edges].mean()) if edges.any() else 0.0
     return RecoverySummary(plan, changed, share)

@@ -18,14 +18,15 @@ from .params import (DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, STRENGTH, Param
                      check_gl_path, check_mode)
 from .plan import make_plan
 from .plan.order import check_order
+from .sample import array_sample
 from .tiling import DEFAULT_TILES, check_tile_size, halo_for, tiles
 
-__all__ = ["recover"]
+__all__ = ["recover", "recover_tiles"]
 
 
 def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
             backend="auto", linear=False, blend_space=None, return_maps=False, tile_size=None, engine=None,
-            mode=DEFAULT_MODE, gl_path="auto", strength=STRENGTH.default):
+            mode=DEFAULT_MODE, gl_path="auto", strength=STRENGTH.default, plan=None):
     """Repair the antialiased edges of `filtered` using the edges of `original`.
 
     Parameters
@@ -70,6 +71,11 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
         the strength the mode chooses (``"safe"``: per image; ``"paper"``: 1). It also
         forces a repair where the safe default would keep `filtered` (a blur, a photo under
         a neighbourhood filter).
+    plan : Plan, optional
+        The pair's plan when it is already made (``aarecovery.plan.make_plan`` on the
+        window ``aarecovery.sample`` picks, as this function would make it): the batch
+        makes it in a worker process. It then decides instead of the parameters, `mode`,
+        `strength` and `blend_space`.
 
     Returns
     -------
@@ -113,9 +119,12 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     order = check_order(original, filtered, linear=linear)
     if order.looks_reversed:
         warnings.warn(order.reason, OrderWarning, stacklevel=2)
-    # Every decision on the whole image, before tiling, so that tiled == untiled.
+    # Every decision on the whole image, before tiling, so that tiled == untiled; the
+    # analysis reads the window that aarecovery.sample chooses, as a streamed pair does.
     try:
-        plan = make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space)
+        if plan is None:
+            plan = make_plan(*array_sample(original, filtered), parameters, mode=mode, linear=linear,
+                             blend_space=blend_space)
         if plan.keeps_filtered and not return_maps:
             if engine is not None:
                 engine.last_plan = plan
@@ -150,26 +159,69 @@ def _recover_in_tiles(original, filtered, f_layout, plan, engine, tile, linear, 
     maps = None
     if return_maps:
         maps = RecoveryMaps(*(np.empty((height, width), np.float32) for _ in RecoveryMaps.NAMES))
-    pending = None
-    for inner, outer in tiles(height, width, tile, halo_for(plan.iterations)):
-        engine.set_images(original[outer], filtered[outer], linear=linear, blend_space=plan.blend_space)
-        engine.run(plan, maps=return_maps, wait=False)
-        crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
+    pieces = recover_tiles(engine, lambda outer: (original[outer], filtered[outer]), plan,
+                           tiles(height, width, tile, halo_for(plan.iterations)), f_layout, linear=linear,
+                           maps=return_maps, into=result)
+    for inner, _, tile_maps in pieces:
         if return_maps:
-            tile_maps = engine.maps()
             for name in RecoveryMaps.NAMES:
-                getattr(maps, name)[inner] = getattr(tile_maps, name)[crop]
-        # This tile's readback starts before the previous tile is folded into the result,
-        # so that on a GPU the copy overlaps the CPU's work.
-        started = engine.start_result(crop)
-        if pending is not None:
-            _fold(pending, result, f_layout)
-        pending = (started, inner)
-    if pending is not None:
-        _fold(pending, result, f_layout)
+                getattr(maps, name)[inner] = getattr(tile_maps, name)
     return (result, maps) if return_maps else result
 
 
-def _fold(pending, result, layout):
-    started, inner = pending
-    from_rgba_float(started.wait(), layout, out=result[inner])
+def recover_tiles(engine, read, plan, pieces, layout, *, linear=False, maps=False, into=None):
+    """Run a resolved plan tile by tile: the loop of :func:`recover`, for any source of pixels.
+
+    Each tile's readback starts before the previous tile is handed over, so that on a GPU
+    the copy overlaps the caller's work on the previous tile.
+
+    Parameters
+    ----------
+    engine : Engine
+    read : callable
+        ``read(outer) -> (original, filtered)``: the pair's pixels in the rows and columns
+        ``outer`` (a tuple of two slices), in the caller's layout and dtype.
+    plan : Plan
+        Made once for the whole pair.
+    pieces : iterable of (inner, outer)
+        Tiles with halos, from ``aarecovery.tiling.tiles``.
+    layout : Layout
+        The filtered image's (``aarecovery.contract.layout_of``): the results' channels and dtype.
+    linear, maps : bool
+        The pair holds linear light; also give each tile's maps.
+    into : ndarray, optional
+        The whole result, to write each tile's part into (no copy); by default each tile's
+        result is a new array.
+
+    Yields
+    ------
+    inner : tuple of slice
+    result : ndarray
+        R on `inner`, in the filtered image's layout and dtype (a view of `into` if given).
+    maps : RecoveryMaps or None
+        The maps on `inner`, with ``maps=True``.
+    """
+    pending = None
+    for inner, outer in pieces:
+        original, filtered = read(outer)
+        engine.set_images(original, filtered, linear=linear, blend_space=plan.blend_space)
+        engine.run(plan, maps=maps, wait=False)
+        crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
+        tile_maps = None
+        if maps:
+            whole = engine.maps()
+            tile_maps = RecoveryMaps(*(getattr(whole, name)[crop] for name in RecoveryMaps.NAMES))
+        started = engine.start_result(crop)
+        if pending is not None:
+            yield _finished(pending, layout, into)
+        pending = (inner, started, tile_maps)
+    if pending is not None:
+        yield _finished(pending, layout, into)
+
+
+def _finished(pending, layout, into):
+    inner, started, tile_maps = pending
+    height, width = (part.stop - part.start for part in inner)
+    out = into[inner] if into is not None else np.empty((height, width) + layout.shape[2:], layout.dtype)
+    from_rgba_float(started.wait(), layout, out=out)
+    return inner, out, tile_maps

@@ -11,7 +11,7 @@ import warnings
 
 from .errors import InputError, TileSizeWarning
 
-__all__ = ["DEFAULT_TILES", "SENSIBLE_TILE", "halo_for", "tiles", "smallest_tile", "sensible_tile",
+__all__ = ["DEFAULT_TILES", "SENSIBLE_TILE", "halo_for", "tiles", "aligned_tiles", "smallest_tile", "sensible_tile",
            "check_tile_size"]
 
 #: The tile side each backend runs at by default, in pixels. NumPy: its passes hold about
@@ -84,6 +84,36 @@ def check_tile_size(tile_size, iterations, name="tile_size", image_size=None):
         if image_size is not None and max(image_size) > tile_size:
             warnings.warn(why, TileSizeWarning, stacklevel=3)
     return int(tile_size)
+
+
+def aligned_tiles(height, width, step, halo):
+    """Like :func:`tiles`, with each tile's part on a grid of `step` pixels.
+
+    A tiled TIFF is written in tiles of its own grid: a streamed pair decides each of them
+    whole, in order (``aarecovery.stream``). Every window has one shape, the part and
+    `halo` on each side, shifted inwards at the image's borders.
+
+    Yields
+    ------
+    inner, outer : tuple of slice
+        As for :func:`tiles`; `inner` starts at multiples of `step`.
+    """
+    if step < 1:
+        raise ValueError(f"a grid of {step} pixels has no tiles")
+    for rows, outer_rows in _aligned_spans(height, step, halo):
+        for columns, outer_columns in _aligned_spans(width, step, halo):
+            yield (rows, columns), (outer_rows, outer_columns)
+
+
+def _aligned_spans(length, step, halo):
+    if length <= step:
+        return [(slice(0, length), slice(0, length))]
+    window = min(length, step + 2 * halo)
+    spans = []
+    for start in range(0, length, step):
+        first = min(max(0, start - halo), length - window)
+        spans.append((slice(start, min(start + step, length)), slice(first, first + window)))
+    return spans
 
 
 def _spans(length, tile, halo):

@@ -5,9 +5,10 @@
 #
 # As root it installs the Debian packages the tests drive for real (Mesa's EGL/llvmpipe for
 # the GL backend, Xvfb for the viewer window, gegl and gmic for the eval's peer tools and,
-# with imagemagick and the DejaVu fonts, its real-tools suite,
-# debootstrap for the GIMP 3 sandbox) and builds or refreshes the GIMP 3 sandbox (a Debian
-# trixie root, cached outside the checkout). Without root it installs nothing system-wide and
+# with imagemagick and the DejaVu fonts, its real-tools suite (imagemagick and gmic also for
+# the batch's filter commands), debootstrap for the GIMP 3 sandbox) and builds or refreshes
+# the GIMP 3 sandbox (a Debian trixie root, cached outside the checkout). Without root it
+# installs nothing system-wide and
 # says loudly what is missing; the tests that need it then fail in CI or skip with a message.
 # The Python side always goes into .venv in the checkout.
 set -euo pipefail

@@ -459,3 +459,10 @@ def test_jpeg_exif_orientation_is_applied(tmp_path):
     exif[0x0112] = 6  # Orientation: the camera was turned; viewers rotate 90 degrees clockwise.
     image.save(tmp_path / "turned.jpg", exif=exif)
     assert read_image(tmp_path / "turned.jpg").shape == (8, 4, 3)
+
+
+def test_a_flipped_or_strided_view_is_written(tmp_path):
+    image = np.arange(6 * 8 * 3, dtype=np.uint8).reshape(6, 8, 3)
+    for name, view in (("flipped.png", image[:, ::-1]), ("channel.png", image[..., 1]), ("every-other.tif", image[::2])):
+        write_image(tmp_path / name, view)
+        np.testing.assert_array_equal(read_image(tmp_path / name), view)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import aarecovery
-from aarecovery.tiling import halo_for, tiles
+from aarecovery.tiling import aligned_tiles, halo_for, tiles
 from scenes import shapes
 
 
@@ -62,6 +62,23 @@ def test_tiles_cover_the_image_once_in_windows_of_one_shape(height, width, tile,
             assert 0 <= window.start <= max(0, part.start - halo)
             assert min(length, part.stop + halo) <= window.stop <= length
             assert window.stop - window.start <= tile
+        shapes_seen.add(tuple(window.stop - window.start for window in outer))
+    assert (covered == 1).all()
+    assert len(shapes_seen) == 1
+
+
+@pytest.mark.parametrize("height, width, step, halo", [(53, 71, 16, 3), (140, 290, 64, 4), (30, 30, 64, 4),
+                                                       (70, 33, 32, 2)])
+def test_aligned_tiles_sit_on_the_grid_and_cover_the_image_once(height, width, step, halo):
+    # A streamed TIFF is written in its own grid's tiles: each part is one of them, whole.
+    covered = np.zeros((height, width), int)
+    shapes_seen = set()
+    for inner, outer in aligned_tiles(height, width, step, halo):
+        covered[inner] += 1
+        for part, window, length in zip(inner, outer, (height, width)):
+            assert part.start % step == 0 and part.stop == min(part.start + step, length)
+            assert 0 <= window.start <= max(0, part.start - halo)
+            assert min(length, part.stop + halo) <= window.stop <= length
         shapes_seen.add(tuple(window.stop - window.start for window in outer))
     assert (covered == 1).all()
     assert len(shapes_seen) == 1

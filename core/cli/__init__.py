@@ -17,6 +17,7 @@ from ..errors import AarecoveryWarning, InputError, NotEnoughMemory
 from ..extras import extra_for, missing_extra
 from ..gimp import cli as gimp_command
 from ..viewer import cli as view_command
+from . import batch as batch_command
 from . import bench as bench_command
 from . import demo as demo_command
 from . import eval as eval_command
@@ -26,7 +27,7 @@ from . import recover as recover_command
 __all__ = ["main", "build_parser"]
 
 #: Subcommand modules, in the order ``--help`` lists them.
-COMMANDS = (recover_command, bench_command, filters_command, eval_command, demo_command, gimp_command,
+COMMANDS = (recover_command, batch_command, bench_command, filters_command, eval_command, demo_command, gimp_command,
             view_command)
 
 _EPILOG = """\
@@ -34,6 +35,7 @@ examples:
   aarecovery demo                                   repair a bundled sample, write a comparison sheet
   aarecovery recover photo.png thresholded.png -o repaired.png
   aarecovery recover o.tif f.tif -o r.tif --sigma-e 0.02 --maps maps/
+  aarecovery batch originals/ filtered/ -o repaired/ --report report.csv
   aarecovery bench                                  throughput of each backend
 
 Run 'aarecovery COMMAND --help' for the options of one command.

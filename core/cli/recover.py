@@ -5,16 +5,12 @@ import os
 
 # Already imported with the package; the codecs and the engine's backends load in run().
 from ..errors import InputError
+from ..io.maps import MAP_SCALES, map_paths, maps_as_images
 from ..params import BACKENDS, BLEND_SPACES, GL_PATHS, PARAMETERS
 from ..tiling import DEFAULT_TILES, SENSIBLE_TILE
 from .inputs import add_image_memory_option
 
-__all__ = ["register", "run", "summary_line", "add_parameter_options", "MAP_SCALES"]
-
-#: Factor each map is multiplied by before it is clipped to [0, 1] and stored as 16-bit
-#: grey; ``"sqrt"`` stores the square root, the geometric mean of O's and F's Sobel
-#: magnitudes, which makes the weak edges that sigma_e decides about visible.
-MAP_SCALES = {"alpha": 1.0, "beta": 1.0, "edge_strength": "sqrt", "residual": 10.0}
+__all__ = ["register", "run", "summary_line", "add_recovery_options", "add_parameter_options", "MAP_SCALES"]
 
 _DESCRIPTION = """\
 Repair the antialiased edges of FILTERED (the image after a nonlinear filter) using the
@@ -54,6 +50,20 @@ def register(subparsers):
     parser.add_argument("filtered", metavar="FILTERED", help="the same image after the filter, same size")
     parser.add_argument("-o", "--output", metavar="OUTPUT", required=True,
                         help="where to write the result; its folder must exist")
+    add_recovery_options(parser)
+    parser.add_argument("--maps", metavar="DIR",
+                        help="also write alpha, beta, edge_strength and residual maps as 16-bit PNGs "
+                             "into DIR (created if missing); scales below")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="allow OUTPUT to replace ORIGINAL or FILTERED (any other existing file "
+                             "is always replaced)")
+    add_image_memory_option(parser)
+    parser.set_defaults(run=run)
+    return parser
+
+
+def add_recovery_options(parser):
+    """The recovery's options, shared by ``recover`` and ``batch``: parameters, backend, mode, tiles."""
     add_parameter_options(parser)
     parser.add_argument("--backend", choices=BACKENDS, default="auto",
                         help="auto uses OpenGL and falls back to NumPy (default %(default)s)")
@@ -68,20 +78,11 @@ def register(subparsers):
     parser.add_argument("--paper", action="store_true",
                         help="the published method exactly, without the safeguards that keep the "
                              "result from being worse than FILTERED on blurred or textured images")
-    parser.add_argument("--maps", metavar="DIR",
-                        help="also write alpha, beta, edge_strength and residual maps as 16-bit PNGs "
-                             "into DIR (created if missing); scales below")
-    parser.add_argument("--overwrite", action="store_true",
-                        help="allow OUTPUT to replace ORIGINAL or FILTERED (any other existing file "
-                             "is always replaced)")
-    add_image_memory_option(parser)
     parser.add_argument("--tile-size", type=int, metavar="N",
                         help="largest tile side in pixels; larger images are processed in overlapping "
                              f"tiles with the same result (default: {DEFAULT_TILES['gl']} on a GPU, "
                              f"{DEFAULT_TILES['gl-software']} on a CPU renderer, {DEFAULT_TILES['numpy']} on "
-                             f"NumPy; at least {SENSIBLE_TILE})")
-    parser.set_defaults(run=run)
-    return parser
+                             f"NumPy; at least {SENSIBLE_TILE}); tiled TIFFs are streamed in tiles of this size")
 
 
 def add_parameter_options(parser):
@@ -90,17 +91,6 @@ def add_parameter_options(parser):
         default = f"default: {spec.automatic}" if spec.automatic else "default %(default)s"
         parser.add_argument(spec.option, type=spec.kind, default=spec.default, metavar="N" if spec.kind is int else "X",
                             help=f"{spec.help} ({spec.minimum:g} to {spec.maximum:g}; {default})")
-
-
-def _map_paths(folder):
-    return {name: os.path.join(folder, f"{name}.png") for name in MAP_SCALES}
-
-
-def _visible_map(values, scale):
-    import numpy as np
-
-    scaled = np.sqrt(np.maximum(values, 0)) if scale == "sqrt" else values * np.float32(scale)
-    return np.rint(np.clip(scaled, 0, 1) * 65535).astype(np.uint16)
 
 
 def _read_pair(args):
@@ -136,7 +126,7 @@ def run(args):
     if args.maps is not None:
         if os.path.exists(args.maps) and not os.path.isdir(args.maps):
             raise InputError(f"--maps {args.maps} is a file; give a folder to write the maps into")
-        outputs += _map_paths(args.maps).values()
+        outputs += map_paths(args.maps).values()
     # Every destination before anything is read, computed or written.
     check_destinations(outputs, inputs, overwrite=args.overwrite, folders=[args.maps] if args.maps else [])
     remove_stale_parts_of(outputs)
@@ -144,6 +134,12 @@ def run(args):
     # Before reading: a backend that cannot run (no OpenGL) says so at once.
     engine = Engine(args.backend, gl_path=args.gl_path)
     try:
+        pair = None if args.maps is not None else _open_streamed(args, params, engine)
+        if pair is not None:
+            with pair:
+                for line in _recover_streamed(args, params, pair, engine):
+                    print(line)
+            return 0
         original, filtered = _read_pair(args)
         # Before the recovery, so that a long run does not end in a refusal.
         check_output_path(args.output, filtered.shape)
@@ -163,8 +159,7 @@ def run(args):
     images = {args.output: result}
     if maps is not None:
         os.makedirs(args.maps, exist_ok=True)
-        for name, path in _map_paths(args.maps).items():
-            images[path] = _visible_map(getattr(maps, name), MAP_SCALES[name])
+        images.update(maps_as_images(args.maps, maps))
     # All or none: a failure while writing any map leaves the result unwritten too.
     write_images(images)
     message = (f"wrote {args.output} ({result.shape[1]}x{result.shape[0]}, {result.dtype}) "
@@ -176,8 +171,34 @@ def run(args):
     return 0
 
 
-def summary_line(plan, original, filtered, recovered):
-    """What the recovery did, in the command line's words."""
-    from ..outcome import summarize_recovery
+def summary_line(plan, original=None, filtered=None, recovered=None):
+    """What the recovery did, in the command line's words (the plan alone for a streamed pair)."""
+    from ..outcome import RecoverySummary, summarize_recovery
 
-    return summarize_recovery(plan, original, filtered, recovered).line(force="--strength 1")
+    summary = (RecoverySummary(plan, None, None) if recovered is None
+               else summarize_recovery(plan, original, filtered, recovered))
+    return summary.line(force="--strength 1")
+
+
+def _open_streamed(args, params, engine):
+    """A pair of TIFFs that can be read in pieces and is larger than a tile, else None."""
+    from ..stream import open_pair, resolve_tile
+
+    return open_pair(args.original, args.filtered, resolve_tile(engine.capabilities, args.tile_size),
+                     params.iterations)
+
+
+def _recover_streamed(args, params, pair, engine):
+    """Recover a pair of TIFFs tile by tile from file to file; return the lines to print."""
+    import time
+
+    from ..io import check_output_path
+    from ..stream import plan_pair, recover_pair
+
+    check_output_path(args.output, pair.result_shape)
+    start = time.perf_counter()
+    plan = plan_pair(pair, params, mode="paper" if args.paper else "safe", linear=args.linear,
+                     blend_space=args.blend_space)
+    recover_pair(pair, args.output, plan, engine=engine, tile=args.tile_size, linear=args.linear)
+    return (f"wrote {args.output} ({pair.width}x{pair.height}, {pair.result_dtype}) with the {engine.backend} "
+            f"backend in {time.perf_counter() - start:.2f} s, streamed in tiles", summary_line(plan))

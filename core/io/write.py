@@ -16,7 +16,7 @@ from .parts import create_part
 from .png import write_png
 
 __all__ = ["write_image", "write_images", "check_output_path", "check_writable_folder", "DiskError",
-           "disk_error"]
+           "disk_error", "tiff_options"]
 
 _JPEG_QUALITY = 95
 
@@ -142,6 +142,13 @@ def _encoded_pixels(image, format_name):
     return np.rint(image / np.float32(257)).astype(np.uint8)
 
 
+def tiff_options(channels):
+    """How a TIFF of `channels` samples is stored (tifffile's ``write`` keywords), whole or in tiles."""
+    return dict(photometric="rgb" if channels >= 3 else "minisblack",
+                extrasamples=("unassalpha",) if channels in (2, 4) else None,
+                compression="zlib", predictor=True, metadata=None)
+
+
 def _encode(file, pixels, format_name):
     if format_name == "NPY":
         # Header and data by file.write, not ndarray.tofile (what np.save does), whose short
@@ -152,11 +159,7 @@ def _encode(file, pixels, format_name):
         write_png(file, pixels)
     elif format_name == "TIFF":
         tifffile = import_codec("tifffile", "TIFF")
-        channels = 1 if pixels.ndim == 2 else pixels.shape[2]
-        tifffile.imwrite(
-            file, pixels, photometric="rgb" if channels >= 3 else "minisblack",
-            extrasamples=("unassalpha",) if channels in (2, 4) else None,
-            compression="zlib", predictor=True, metadata=None)
+        tifffile.imwrite(file, pixels, **tiff_options(1 if pixels.ndim == 2 else pixels.shape[2]))
     else:
         _encode_with_pillow(file, pixels, format_name)
 

@@ -1,0 +1,131 @@
+"""Making F inside the batch: a built-in filter, or any command-line tool the user already has.
+
+A command is a template such as ``convert {in} -threshold 50% {out}`` (ImageMagick 6),
+``magick {in} -threshold 50% {out}`` (ImageMagick 7), ``gmic {in} -quantize 4 -o {out}``
+or ``gegl {in} -o {out} -- gegl:levels in-high=0.6``. It is split into words first (POSIX
+shell quoting rules, no shell runs it), then ``{in}`` and ``{out}`` are replaced inside
+each word, so paths with spaces need no quoting. The command reads a temporary copy of
+the original, so a tool that writes into its input cannot touch it, and writes a file in
+the same temporary folder, in the original's format unless ``{out}`` is given an
+extension (``{out}.png``); a non-zero exit status, or no output file, fails that image with
+the tool's own message.
+"""
+
+import os
+import re
+import shlex
+import shutil
+import subprocess
+from dataclasses import dataclass, field
+
+from ..errors import InputError
+
+__all__ = ["BuiltinFilter", "FilterCommand", "FilterFailed"]
+
+# The last lines of a failing tool's stderr that are reported (a tool may print pages).
+_STDERR_LINES = 3
+
+
+class FilterFailed(InputError):
+    """The filter command of a batch failed on one image (its exit status and message)."""
+
+
+@dataclass(frozen=True)
+class BuiltinFilter:
+    """One of ``aarecovery.filters``, with its parameters.
+
+    Attributes
+    ----------
+    name : str
+    params : dict
+    """
+
+    name: str
+    params: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        from ..filters import get_filter
+        get_filter(self.name)
+
+    def describe(self):
+        """str: the filter as a user would write it."""
+        return " ".join([self.name] + [f"{key}={value!r}" for key, value in self.params.items()])
+
+    def apply(self, original):
+        """F for the array `original`, in its layout and dtype."""
+        from ..filters import apply
+        return apply(self.name, original, **self.params)
+
+
+@dataclass(frozen=True)
+class FilterCommand:
+    """A command-line tool run on each original, as a template with ``{in}`` and ``{out}``.
+
+    Attributes
+    ----------
+    template : str
+    timeout : float or None
+        Seconds after which the command is stopped and the image failed.
+    """
+
+    template: str
+    timeout: float = None
+
+    def __post_init__(self):
+        words = self.words()
+        if not words:
+            raise InputError("--filter-cmd is empty; give a command such as 'convert {in} -threshold 50% {out}'")
+        joined = " ".join(words)
+        for placeholder in ("{in}", "{out}"):
+            if placeholder not in joined:
+                raise InputError(f"--filter-cmd {self.template!r} has no {placeholder}; the command must read "
+                                 "{in} and write {out}, for example 'convert {in} -threshold 50% {out}'")
+        if shutil.which(words[0]) is None:
+            raise InputError(f"--filter-cmd: the program {words[0]!r} is not found on PATH; install it or give "
+                             "its full path")
+
+    def words(self):
+        try:
+            return shlex.split(self.template)
+        except ValueError as error:
+            raise InputError(f"--filter-cmd {self.template!r} cannot be split into words ({error}); check "
+                             "its quotes") from None
+
+    def describe(self):
+        return self.template
+
+    def run(self, original_path, folder):
+        """Run the command on a copy of `original_path` inside `folder`; return the output's path.
+
+        Raises
+        ------
+        FilterFailed
+            On a non-zero exit status, a time-out, or no output file.
+        """
+        extension = os.path.splitext(original_path)[1]
+        copy = os.path.join(folder, "original" + extension)
+        shutil.copyfile(original_path, copy)
+        chosen = re.search(r"\{out\}(\.\w+)", self.template)
+        output = os.path.join(folder, "filtered")
+        produced = output + (chosen.group(1) if chosen else extension)
+        target = output if chosen else produced
+        words = [word.replace("{in}", copy).replace("{out}", target) for word in self.words()]
+        try:
+            finished = subprocess.run(words, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                      stderr=subprocess.PIPE, timeout=self.timeout, cwd=folder)
+        except subprocess.TimeoutExpired:
+            raise FilterFailed(f"the filter command did not finish within {self.timeout:g} s ({self.template})") \
+                from None
+        except OSError as error:
+            raise FilterFailed(f"the filter command could not start: {error}") from None
+        # Without terminal colour codes (G'MIC colours its messages).
+        text = re.sub(r"\x1b\[[0-9;]*m", "", finished.stderr.decode(errors="replace"))
+        message = " | ".join(line.strip() for line in text.strip().splitlines()[-_STDERR_LINES:])
+        if finished.returncode != 0:
+            raise FilterFailed(f"the filter command exited with status {finished.returncode}"
+                               + (f": {message}" if message else "") + f" ({self.template})")
+        if not os.path.isfile(produced):
+            raise FilterFailed(f"the filter command wrote no {os.path.basename(produced)} ({self.template})"
+                               + (f": {message}" if message else ""))
+        return produced
+

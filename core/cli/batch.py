@@ -1,0 +1,185 @@
+"""``aarecovery batch``: many image pairs, or originals and a filter, with one engine."""
+
+import argparse
+import os
+import sys
+import time
+
+from ..errors import InputError
+from .recover import add_recovery_options
+
+__all__ = ["register", "run"]
+
+_DESCRIPTION = """\
+Repair many images with one engine. Give two folders (pairs are matched by relative path)
+or two quoted glob patterns (matched by what their wildcards match), or ORIGINALS alone
+with --filter or --filter-cmd to make each filtered image. Results keep their relative
+paths, formats and bit depths under OUTPUT. A bad file or a failing filter command does
+not stop the batch: it is reported at the end and the exit status is 1. Every result is
+written atomically, and a re-run skips results that are complete and newer than their
+inputs, so an interrupted batch resumes where it stopped (--force redoes everything).
+Pairs of TIFF files that can be read in pieces (tiled or in strips) are streamed tile by
+tile, in memory bounded by the tile size."""
+
+_EPILOG = """\
+examples:
+  aarecovery batch originals/ filtered/ -o repaired/
+  aarecovery batch 'scans/*.png' 'bw/*-bw.png' -o repaired/
+  aarecovery batch scans/ -o repaired/ --filter threshold level=0.5
+  aarecovery batch scans/ -o repaired/ --filter-cmd 'convert {in} -threshold 50% {out}' --keep-filtered bw/
+  aarecovery batch icons/ -o repaired/ --filter-cmd 'gmic {in} -quantize 4 -o {out}' --report report.csv
+  aarecovery batch maps/ -o repaired/ --filter-cmd 'gegl {in} -o {out} -- gegl:levels in-high=0.6'
+  aarecovery batch originals/ filtered/ -o repaired/ --dask tcp://scheduler:8786
+
+filter commands: the template is split into words like a shell would (no shell runs it);
+{in} is a temporary copy of the original, {out} the file the tool must write, in the
+original's format unless written with an extension ({out}.png). ImageMagick 6 is
+'convert', ImageMagick 7 'magick'. For pipes or redirection run a shell: 'sh -c "..."'.
+"""
+
+
+def register(subparsers):
+    """Add ``aarecovery batch``."""
+    parser = subparsers.add_parser(
+        "batch", help="repair many images: two folders, two globs, or originals and a filter",
+        description=_DESCRIPTION, epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("originals", metavar="ORIGINALS", help="a folder of originals, or a quoted glob")
+    parser.add_argument("filtered", metavar="FILTERED", nargs="?",
+                        help="a folder of filtered images, or a quoted glob (not with --filter/--filter-cmd)")
+    parser.add_argument("-o", "--output", metavar="OUTPUT", required=True,
+                        help="the folder for the results (created if missing)")
+    making = parser.add_mutually_exclusive_group()
+    making.add_argument("--filter", nargs="+", metavar=("NAME", "PARAM=VALUE"),
+                        help="make each filtered image with a built-in filter ('aarecovery filters' lists them), "
+                             "e.g. --filter threshold level=0.5")
+    making.add_argument("--filter-cmd", metavar="TEMPLATE",
+                        help="make each filtered image with a command-line tool: a template with {in} and {out}")
+    parser.add_argument("--filter-timeout", type=float, metavar="SECONDS",
+                        help="stop a filter command after this long and report the image as failed")
+    parser.add_argument("--keep-filtered", metavar="DIR",
+                        help="keep each filtered image the batch makes in DIR, under its relative path")
+    add_recovery_options(parser)
+    parser.add_argument("--maps", metavar="DIR",
+                        help="also write each image's maps (as 'recover --maps') into DIR/NAME/; pairs are then "
+                             "read whole")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="allow a result to replace its original or filtered image")
+    parser.add_argument("--format", metavar="EXT",
+                        help="write every result in this format (png, tif, ...) instead of the filtered image's")
+    parser.add_argument("--force", action="store_true",
+                        help="redo results that are complete and newer than their inputs")
+    parser.add_argument("--report", metavar="FILE",
+                        help="write per image the time, size, plan (mode, blend space, strength, reason) and "
+                             "backend to FILE (.csv or .json)")
+    parser.add_argument("--workers", type=int, metavar="N",
+                        help="analysis processes beside the engine, and N + 1 threads that read, filter and "
+                             "write (default: a measured rule, one per core of this machine)")
+    parser.add_argument("--dask", metavar="ADDRESS",
+                        help="run on a Dask cluster: a scheduler address (tcp://host:8786) or 'local'; paths must "
+                             "be on storage every worker sees (needs pip install 'aarecovery[dask]')")
+    parser.set_defaults(run=run)
+    return parser
+
+
+def _jobs(args, makes_filtered):
+    from ..batch import find_images, find_pairs, make_jobs
+
+    if makes_filtered:
+        if args.filtered is not None:
+            raise InputError("give ORIGINALS alone with --filter or --filter-cmd (the filter makes the filtered "
+                             f"images), not also {args.filtered}")
+        return make_jobs([(path, None, name) for name, path in find_images(args.originals)], True), []
+    if args.filtered is None:
+        raise InputError("give the FILTERED folder (or glob) after ORIGINALS, or make the filtered images with "
+                         "--filter NAME or --filter-cmd TEMPLATE")
+    return find_pairs(args.originals, args.filtered)
+
+
+def _filter_options(args):
+    if not args.filter:
+        return {}
+    from .. import filters
+    from .filters import parse_params
+
+    spec = filters.get_filter(args.filter[0])
+    for word in args.filter[1:]:
+        if "=" not in word:
+            raise InputError(f"--filter {' '.join(args.filter)}: {word!r} is not PARAM=VALUE; --filter takes the "
+                             "words up to the next option, so put it after ORIGINALS")
+    return {"filter": spec.name, "filter_params": parse_params(args.filter[1:], spec)}
+
+
+class _Progress:
+    """A progress bar with rate and ETA (tqdm) on a terminal; silent otherwise."""
+
+    def __init__(self, total):
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=total, unit="image", file=sys.stderr, disable=None, dynamic_ncols=True,
+                        smoothing=0.1)
+        self.results = []
+
+    def __call__(self, result, done, total):
+        self.results.append(result)
+        if result.status == "failed":
+            self.bar.set_postfix(failed=sum(r.status == "failed" for r in self.results), refresh=False)
+        self.bar.update(1)
+
+    def close(self):
+        self.bar.close()
+
+
+def run(args):
+    """Run ``aarecovery batch`` with parsed arguments; return the exit status."""
+    from ..batch import ImageResult, check_report_path, make_settings, run_jobs, summary, write_report
+    from ..batch.storage import is_url
+
+    if args.workers is not None and args.workers < 1:
+        raise InputError(f"--workers must be at least 1, got {args.workers}")
+    if args.report:
+        check_report_path(args.report)
+    if args.filter_timeout is not None and args.filter_timeout <= 0:
+        raise InputError(f"--filter-timeout must be a number of seconds above 0, got {args.filter_timeout:g}")
+    settings = make_settings(
+        output=args.output, filter_command=args.filter_cmd, filter_timeout=args.filter_timeout,
+        keep_filtered=args.keep_filtered, maps=args.maps, format=args.format, force=args.force,
+        overwrite=args.overwrite, sigma_d=args.sigma_d, sigma_e=args.sigma_e, iterations=args.iterations,
+        strength=args.strength, gl_path=args.gl_path, backend=args.backend, linear=args.linear, blend_space=args.blend_space, tile_size=args.tile_size,
+        mode="paper" if args.paper else "safe", **_filter_options(args))
+    jobs, unmatched = _jobs(args, settings.filter is not None)
+    missing = [ImageResult(os.path.relpath(path, args.originals) if os.path.isdir(args.originals) else path,
+                           status="failed", error=f"no filtered image matches {path}") for path in unmatched]
+    if not args.dask and not is_url(args.output):
+        os.makedirs(args.output, exist_ok=True)
+    engine = None
+    if jobs and not args.dask:
+        from ..engine import Engine
+        # A missing OpenGL is said at once, in one line (GLUnavailable is an InputError).
+        engine = Engine(settings.backend, gl_path=settings.gl_path)
+    progress = _Progress(len(jobs))
+    start = time.perf_counter()
+    interrupted = False
+    finished = []
+    try:
+        finished = run_jobs(jobs, settings, workers=args.workers, progress=progress, dask=args.dask, engine=engine)
+    except KeyboardInterrupt:
+        finished = progress.results
+        interrupted = True
+    finally:
+        progress.close()
+        if engine is not None:
+            engine.release()
+    seconds = time.perf_counter() - start
+    results = sorted(missing + list(finished), key=lambda result: result.name)
+    for result in results:
+        if result.status == "failed":
+            print(f"aarecovery: failed: {result.name}: {result.error}", file=sys.stderr)
+    if args.report:
+        write_report(args.report, results)
+    print(summary(results, seconds) + (f"; report in {args.report}" if args.report else ""))
+    if interrupted:
+        print(f"aarecovery: interrupted after {len(progress.results)} of {len(jobs)} images; every result written "
+              "is complete: run the same command again to finish", file=sys.stderr)
+        return 130
+    return 1 if any(result.status == "failed" for result in results) else 0
+
