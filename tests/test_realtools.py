@@ -236,3 +236,45 @@ def test_eval_command_refuses_crossing_the_split(argv, message, capsys):
     from aarecovery.cli import main
     assert main(["eval", *argv]) == 1
     assert message in capsys.readouterr().err
+
+
+def test_thin_spokes_under_narrow_levels_are_not_painted_red(backend):
+    """The invented colour of issue 10: dark-blue spokes on tan under ``gegl:levels in-low=0.3
+    in-high=0.4`` came back as red spokes up to 0.46 where F and the reference are black (419
+    pixels, plan "pure colours of thin features")."""
+    import aarecovery
+    require_tool("gegl")
+    suite = realtools.RealToolsSuite("spokes", ("starburst",), ("gegl-levels-narrow",), 96,
+                                     {"starburst": ("linear", "srgb")})
+    cases = realtools.build_cases(suite, "tune", jpeg=False)
+    assert len(cases) == 2
+    for case in cases:
+        engine = aarecovery.Engine(backend)
+        result = aarecovery.recover(case.original, case.filtered, engine=engine)
+        black = (case.filtered.max(axis=-1) < 2 / 255) & (case.reference.max(axis=-1) < 2 / 255)
+        assert black.sum() > 100, "the scene changed: it no longer has black spokes to check"
+        assert result[black].max() <= 2 / 255, (case.space, engine.last_plan.reason, float(result[black].max()))
+        # ... and the spokes are still repaired, not merely left alone.
+        error = lambda image: float(((image - case.reference) ** 2).mean())
+        assert error(result) < 0.2 * error(case.filtered), (case.space, engine.last_plan.reason)
+
+
+def test_safe_default_on_the_held_out_quick_suite():
+    """What the safe default achieves on images and tools it was not tuned on (docs/quality.md).
+
+    Issue 10's never-worse target holds here and is asserted as stated; the other figures are
+    floors a little under today's (0.54, 0.21 and 0.41 on this suite), short of the issue's
+    targets (0.75, 0.3 and 0.8), so that a change that loses ground fails.
+    """
+    from aarecovery.lab.realeval import MAX_LOSS_DB
+    for name in TOOLS:
+        require_tool(name)
+    results, missing_tools, _ = run_realtools(realtools.REAL_QUICK, "heldout", peers=False)
+    assert not missing_tools and len(results) >= 90
+    assert {r.half for r in results} == {"heldout"}
+    summary = summarize_realtools(results)
+    assert summary["losses_over_limit"] == 0, f"worse than F by over {MAX_LOSS_DB} dB: {summary['worst_loss_db']}"
+    assert summary["hard"]["R"] >= 0.5 and summary["hard"]["R"] > summary["hard"]["paper"], summary["hard"]
+    assert not summary["behind_peers"], summary["behind_peers"]
+    assert summary["photo_pointwise"]["R"] >= 0.18, summary["photo_pointwise"]
+    assert summary["jpeg_gain_kept"]["q>=85"]["R"][0] >= 0.35, summary["jpeg_gain_kept"]["q>=85"]
