@@ -330,3 +330,23 @@ def test_a_filter_command_that_runs_too_long_is_stopped_and_reported(tmp_path, c
                                  "--filter-cmd", "sh -c 'sleep 30' {in} {out}", "--filter-timeout", "0.5")
     assert status == 1 and "did not finish within 0.5 s" in err
     assert not (tmp_path / "r" / "a.png").exists() and no_temporary_files(tmp_path) == []
+
+
+def test_max_image_memory_is_the_limit_of_each_image_read(tmp_path, capsys):
+    """A file declaring more than the limit fails alone, with the option that raises it."""
+    write_pairs(tmp_path, ["small.png"])
+    big = shapes(96, seed=3)
+    for sub, image in (("o", big), ("f", threshold(big))):
+        write_image(tmp_path / sub / "big.png", image)
+    limit_gb = (40 * 50 * 3 + 96 * 96 * 3) / 2 / 1e9  # between the two images' decoded sizes
+    status, out, err = run_batch(capsys, tmp_path / "o", tmp_path / "f", "-o", tmp_path / "r", "--backend", "numpy",
+                                 "--max-image-memory", f"{limit_gb:.9f}")
+    assert status == 1 and "1 recovered" in out and "1 failed" in out
+    assert "big.png" in err and "--max-image-memory" in err and "decompression bomb" in err
+    assert (tmp_path / "r" / "small.png").exists() and not (tmp_path / "r" / "big.png").exists()
+    status, out, err = run_batch(capsys, tmp_path / "o", tmp_path / "f", "-o", tmp_path / "r", "--backend", "numpy",
+                                 "--max-image-memory", "1")
+    assert status == 0 and (tmp_path / "r" / "big.png").exists(), err
+    results = aarecovery.recover_many([(tmp_path / "o" / "big.png", tmp_path / "f" / "big.png")], backend="numpy",
+                                      max_bytes=1000)
+    assert results[0].status == "failed" and "limit for one image" in results[0].error, results[0].error

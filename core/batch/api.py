@@ -62,7 +62,8 @@ def make_jobs(pairs, makes_filtered):
 def make_settings(*, output=None, filter=None, filter_params=None, filter_command=None, filter_timeout=None,
                   keep_filtered=None, maps=None, format=None, force=False, overwrite=False, sigma_d=SIGMA_D.default,
                   sigma_e=SIGMA_E.default, iterations=ITERATIONS.default, backend="auto", linear=False,
-                  blend_space=None, tile_size=None, mode=DEFAULT_MODE, strength=STRENGTH.default, gl_path="auto"):
+                  blend_space=None, tile_size=None, mode=DEFAULT_MODE, strength=STRENGTH.default, gl_path="auto",
+                  max_bytes=None):
     """Check the options of a batch and return its :class:`Settings` (see :func:`recover_many`)."""
     parameters = Parameters(sigma_d, sigma_e, iterations, strength)
     check_mode(mode)
@@ -93,17 +94,19 @@ def make_settings(*, output=None, filter=None, filter_params=None, filter_comman
                              "results may be URLs)")
     if output is None and (keep_filtered is not None or maps is not None):
         raise InputError("keep_filtered and maps need an output folder; give output=")
+    if max_bytes is not None and not max_bytes > 0:
+        raise InputError(f"max_bytes must be a positive number of bytes, got {max_bytes!r}")
     return Settings(parameters=parameters, mode=mode, linear=bool(linear), blend_space=blend_space, backend=backend,
                     gl_path=gl_path, tile_size=tile_size, output=None if output is None else os.fspath(output), format=format,
                     filter=maker, keep_filtered=keep_filtered, maps=maps, force=bool(force),
-                    overwrite=bool(overwrite))
+                    overwrite=bool(overwrite), max_bytes=max_bytes)
 
 
 def recover_many(pairs, output=None, *, filter=None, filter_params=None, filter_command=None, filter_timeout=None,
                  keep_filtered=None, maps=None, format=None, force=False, overwrite=False, workers=None,
                  progress=None, dask=None, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default,
                  iterations=ITERATIONS.default, backend="auto", linear=False, blend_space=None, tile_size=None,
-                 mode=DEFAULT_MODE, strength=STRENGTH.default, gl_path="auto", engine=None):
+                 mode=DEFAULT_MODE, strength=STRENGTH.default, gl_path="auto", max_bytes=None, engine=None):
     """Recover many image pairs with one engine, or on a Dask cluster.
 
     A failing image (a bad file, a failing filter command) does not stop the others: its
@@ -149,6 +152,10 @@ def recover_many(pairs, output=None, *, filter=None, filter_params=None, filter_
         be on storage every worker sees (local paths or fsspec URLs), and `output` given.
     sigma_d, sigma_e, iterations, backend, linear, blend_space, tile_size, mode, strength, gl_path
         As for :func:`aarecovery.recover`, for every image.
+    max_bytes : int or float, optional
+        The largest decoded size of one image read whole, as for :func:`aarecovery.read_image`
+        (default 4 GB, or ``AARECOVERY_MAX_IMAGE_MEMORY``); streamed TIFF pairs are read in
+        tiles and are not bound by it.
     engine : Engine, optional
         An engine to use (not with `dask`).
 
@@ -169,7 +176,8 @@ def recover_many(pairs, output=None, *, filter=None, filter_params=None, filter_
                              filter_timeout=filter_timeout, keep_filtered=keep_filtered, maps=maps, format=format,
                              force=force, overwrite=overwrite, sigma_d=sigma_d, sigma_e=sigma_e,
                              iterations=iterations, backend=backend, linear=linear, blend_space=blend_space,
-                             tile_size=tile_size, mode=mode, strength=strength, gl_path=gl_path)
+                             tile_size=tile_size, mode=mode, strength=strength, gl_path=gl_path,
+                             max_bytes=max_bytes)
     jobs = make_jobs(pairs, settings.filter is not None)
     return run_jobs(jobs, settings, workers=workers, progress=progress, dask=dask, engine=engine)
 

@@ -59,6 +59,8 @@ class Settings:
         Redo results that are complete and newer than their inputs.
     overwrite : bool
         Allow a result to replace one of its inputs.
+    max_bytes : int or float or None
+        The decompression-bomb limit of each image read whole (``read_image``'s).
     """
 
     parameters: Parameters = field(default_factory=Parameters)
@@ -75,6 +77,7 @@ class Settings:
     maps: str = None
     force: bool = False
     overwrite: bool = False
+    max_bytes: float = None
 
 
 @dataclass
@@ -299,9 +302,9 @@ def _prepare(work, settings, capabilities, started, planner):
         work.plan = stream.plan_pair(work.pair, settings.parameters, mode=settings.mode, linear=settings.linear,
                                      blend_space=settings.blend_space, planner=planner)
     else:
-        original = read_image(original_path) if original_path else job.original
+        original = read_image(original_path, max_bytes=settings.max_bytes) if original_path else job.original
         if filtered_path:
-            filtered = read_image(filtered_path)
+            filtered = read_image(filtered_path, max_bytes=settings.max_bytes)
         elif job.filtered is not None:
             filtered = job.filtered
         else:

@@ -6,6 +6,7 @@ import sys
 import time
 
 from ..errors import InputError
+from .inputs import add_image_memory_option
 from .recover import add_recovery_options
 
 __all__ = ["register", "run"]
@@ -77,6 +78,7 @@ def register(subparsers):
     parser.add_argument("--dask", metavar="ADDRESS",
                         help="run on a Dask cluster: a scheduler address (tcp://host:8786) or 'local'; paths must "
                              "be on storage every worker sees (needs pip install 'aarecovery[dask]')")
+    add_image_memory_option(parser)
     parser.set_defaults(run=run)
     return parser
 
@@ -144,8 +146,9 @@ def run(args):
         output=args.output, filter_command=args.filter_cmd, filter_timeout=args.filter_timeout,
         keep_filtered=args.keep_filtered, maps=args.maps, format=args.format, force=args.force,
         overwrite=args.overwrite, sigma_d=args.sigma_d, sigma_e=args.sigma_e, iterations=args.iterations,
-        strength=args.strength, gl_path=args.gl_path, backend=args.backend, linear=args.linear, blend_space=args.blend_space, tile_size=args.tile_size,
-        mode="paper" if args.paper else "safe", **_filter_options(args))
+        strength=args.strength, gl_path=args.gl_path, backend=args.backend, linear=args.linear,
+        blend_space=args.blend_space, tile_size=args.tile_size, mode="paper" if args.paper else "safe",
+        max_bytes=None if args.max_image_memory is None else args.max_image_memory * 1e9, **_filter_options(args))
     jobs, unmatched = _jobs(args, settings.filter is not None)
     missing = [ImageResult(os.path.relpath(path, args.originals) if os.path.isdir(args.originals) else path,
                            status="failed", error=f"no filtered image matches {path}") for path in unmatched]
