@@ -92,10 +92,9 @@ start=$(date +%s)
 
 if ! command -v debootstrap >/dev/null 2>&1; then
     say "installing debootstrap on the host"
-    # Wait for the dpkg lock instead of failing: other jobs on the host may be installing.
-    apt-get -o DPkg::Lock::Timeout=600 update -qq
-    DEBIAN_FRONTEND=noninteractive apt-get -o DPkg::Lock::Timeout=600 install -y -qq \
-        --no-install-recommends debootstrap >/dev/null
+    # apt-install.sh waits for both of apt's locks (a fresh machine's unattended upgrades
+    # hold them) and retries the network, as test.sh's own apt step does.
+    bash "$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/apt-install.sh" debootstrap || die "could not install debootstrap"
 fi
 
 if [ -x "$ROOT/usr/bin/apt-get" ]; then

@@ -72,3 +72,10 @@ def test_test_sh_uses_it():
     text = (SCRIPT.parent / "test.sh").read_text()
     assert 'bash packaging/apt-install.sh "${missing[@]}"' in text
     assert "apt-get update" not in text
+
+
+def test_gimp_sandbox_uses_it_on_the_host():
+    # The host's apt runs only to get debootstrap; it must be as patient as test.sh's.
+    text = (SCRIPT.parent / "gimp-sandbox.sh").read_text()
+    assert "apt-install.sh\" debootstrap" in text
+    assert "apt-get -o DPkg::Lock::Timeout=600 update" not in text
