@@ -269,12 +269,14 @@ def test_safe_default_on_the_held_out_quick_suite():
     from aarecovery.lab.realeval import MAX_LOSS_DB
     for name in TOOLS:
         require_tool(name)
-    results, missing_tools, _ = run_realtools(realtools.REAL_QUICK, "heldout", peers=False)
+    results, missing_tools, _ = run_realtools(realtools.REAL_QUICK, "heldout", peers=True)
     assert not missing_tools and len(results) >= 90
     assert {r.half for r in results} == {"heldout"}
     summary = summarize_realtools(results)
     assert summary["losses_over_limit"] == 0, f"worse than F by over {MAX_LOSS_DB} dB: {summary['worst_loss_db']}"
     assert summary["hard"]["R"] >= 0.5 and summary["hard"]["R"] > summary["hard"]["paper"], summary["hard"]
-    assert not summary["behind_peers"], summary["behind_peers"]
+    # GEGL's bilateral filter is the one filter where a peer (the joint bilateral filter) does
+    # better on this half; on every other filter R is ahead of each peer.
+    assert set(summary["behind_peers"]) <= {"gegl-bilateral"}, summary["behind_peers"]
     assert summary["photo_pointwise"]["R"] >= 0.18, summary["photo_pointwise"]
     assert summary["jpeg_gain_kept"]["q>=85"]["R"][0] >= 0.35, summary["jpeg_gain_kept"]["q>=85"]
