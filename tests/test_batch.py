@@ -350,3 +350,18 @@ def test_max_image_memory_is_the_limit_of_each_image_read(tmp_path, capsys):
     results = aarecovery.recover_many([(tmp_path / "o" / "big.png", tmp_path / "f" / "big.png")], backend="numpy",
                                       max_bytes=1000)
     assert results[0].status == "failed" and "limit for one image" in results[0].error, results[0].error
+
+
+def test_a_filter_command_past_its_time_is_stopped_with_the_processes_it_started(tmp_path, capsys):
+    """A wrapper script's children are stopped too: left running, they would hold the batch
+    (they keep the command's stderr open) and go on writing after it reported the image."""
+    write_pairs(tmp_path, ["a.png"])
+    marker = tmp_path / "still-running"
+    started = time.monotonic()
+    status, out, err = run_batch(capsys, tmp_path / "o", "-o", tmp_path / "r", "--backend", "numpy",
+                                 "--filter-cmd", f"sh -c 'sleep 4 && touch {marker} & wait' {{in}} {{out}}",
+                                 "--filter-timeout", "0.5")
+    assert time.monotonic() - started < 3.5, "the batch waited for the command's children"
+    assert status == 1 and "did not finish within 0.5 s" in err
+    time.sleep(4.5)
+    assert not marker.exists(), "a child of the filter command went on running after the time-out"

@@ -15,6 +15,7 @@ import os
 import re
 import shlex
 import shutil
+import signal
 import subprocess
 from dataclasses import dataclass, field
 
@@ -110,22 +111,50 @@ class FilterCommand:
         produced = output + (chosen.group(1) if chosen else extension)
         target = output if chosen else produced
         words = [word.replace("{in}", copy).replace("{out}", target) for word in self.words()]
-        try:
-            finished = subprocess.run(words, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                      stderr=subprocess.PIPE, timeout=self.timeout, cwd=folder)
-        except subprocess.TimeoutExpired:
-            raise FilterFailed(f"the filter command did not finish within {self.timeout:g} s ({self.template})") \
-                from None
-        except OSError as error:
-            raise FilterFailed(f"the filter command could not start: {error}") from None
+        returncode, stderr = _run_as_group(words, self.timeout, folder, self.template)
         # Without terminal colour codes (G'MIC colours its messages).
-        text = re.sub(r"\x1b\[[0-9;]*m", "", finished.stderr.decode(errors="replace"))
+        text = re.sub(r"\x1b\[[0-9;]*m", "", stderr.decode(errors="replace"))
         message = " | ".join(line.strip() for line in text.strip().splitlines()[-_STDERR_LINES:])
-        if finished.returncode != 0:
-            raise FilterFailed(f"the filter command exited with status {finished.returncode}"
+        if returncode != 0:
+            raise FilterFailed(f"the filter command exited with status {returncode}"
                                + (f": {message}" if message else "") + f" ({self.template})")
         if not os.path.isfile(produced):
             raise FilterFailed(f"the filter command wrote no {os.path.basename(produced)} ({self.template})"
                                + (f": {message}" if message else ""))
         return produced
 
+
+def _run_as_group(words, timeout, folder, template):
+    """Run a command in its own process group; past `timeout`, stop the whole group.
+
+    A filter is often a wrapper (a shell script, ``sh -c``, a tool that forks workers):
+    stopping only the process started would leave its children running, writing into the
+    batch's folders after the image was reported, and holding its stderr open so that the
+    batch waits for them. Returns the exit status and stderr.
+    """
+    try:
+        process = subprocess.Popen(words, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.PIPE, cwd=folder, start_new_session=True)
+    except OSError as error:
+        raise FilterFailed(f"the filter command could not start: {error}") from None
+    try:
+        _, stderr = process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        _kill_group(process)
+        raise FilterFailed(f"the filter command did not finish within {timeout:g} s ({template})") from None
+    except BaseException:
+        _kill_group(process)  # Ctrl+C or SIGTERM of the batch: the filter's processes go too
+        raise
+    return process.returncode, stderr
+
+
+def _kill_group(process):
+    try:
+        if hasattr(os, "killpg"):
+            os.killpg(process.pid, signal.SIGKILL)
+        else:  # Windows has no process groups to signal: the command alone
+            process.kill()
+    except (ProcessLookupError, PermissionError):
+        pass
+    process.stderr.close()
+    process.wait()
