@@ -365,3 +365,26 @@ def test_a_filter_command_past_its_time_is_stopped_with_the_processes_it_started
     assert status == 1 and "did not finish within 0.5 s" in err
     time.sleep(4.5)
     assert not marker.exists(), "a child of the filter command went on running after the time-out"
+
+
+def test_ctrl_c_stops_a_running_filter_command_and_its_children(tmp_path):
+    """The filter runs in a process group of its own (see the time-out test), out of reach of
+    the terminal's Ctrl+C: the interrupted batch must stop it, not wait for it."""
+    write_pairs(tmp_path, ["a.png"])
+    marker, started = tmp_path / "still-running", tmp_path / "started"
+    command = [sys.executable, "-m", "aarecovery", "batch", str(tmp_path / "o"), "-o", str(tmp_path / "r"),
+               "--backend", "numpy", "--filter-cmd",
+               f"sh -c 'touch {started}; sleep 6 && touch {marker} & wait' {{in}} {{out}}"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not started.exists():
+        time.sleep(0.05)
+    time.sleep(0.3)
+    os.killpg(process.pid, signal.SIGINT)
+    interrupted = time.monotonic()
+    out, err = process.communicate(timeout=60)
+    assert process.returncode == 130, err.decode()
+    assert time.monotonic() - interrupted < 4, "the batch waited for the filter command"
+    time.sleep(6.5 - (time.monotonic() - interrupted))
+    assert not marker.exists(), "a child of the filter command went on running after Ctrl+C"
+    assert no_temporary_files(tmp_path) == []

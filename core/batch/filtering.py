@@ -17,6 +17,7 @@ import shlex
 import shutil
 import signal
 import subprocess
+import threading
 from dataclasses import dataclass, field
 
 from ..errors import InputError
@@ -124,6 +125,20 @@ class FilterCommand:
         return produced
 
 
+# The filter commands running now, each its own process group: a new session does not get
+# the terminal's Ctrl+C, so an interrupted batch stops them itself (stop_filter_commands).
+_RUNNING = set()
+_RUNNING_LOCK = threading.Lock()
+
+
+def stop_filter_commands():
+    """Stop every filter command running now, with the processes it started."""
+    with _RUNNING_LOCK:
+        running = list(_RUNNING)
+    for process in running:
+        _signal_group(process)
+
+
 def _run_as_group(words, timeout, folder, template):
     """Run a command in its own process group; past `timeout`, stop the whole group.
 
@@ -137,18 +152,23 @@ def _run_as_group(words, timeout, folder, template):
                                    stderr=subprocess.PIPE, cwd=folder, start_new_session=True)
     except OSError as error:
         raise FilterFailed(f"the filter command could not start: {error}") from None
+    with _RUNNING_LOCK:
+        _RUNNING.add(process)
     try:
         _, stderr = process.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
         _kill_group(process)
         raise FilterFailed(f"the filter command did not finish within {timeout:g} s ({template})") from None
     except BaseException:
-        _kill_group(process)  # Ctrl+C or SIGTERM of the batch: the filter's processes go too
+        _kill_group(process)
         raise
+    finally:
+        with _RUNNING_LOCK:
+            _RUNNING.discard(process)
     return process.returncode, stderr
 
 
-def _kill_group(process):
+def _signal_group(process):
     try:
         if hasattr(os, "killpg"):
             os.killpg(process.pid, signal.SIGKILL)
@@ -156,5 +176,9 @@ def _kill_group(process):
             process.kill()
     except (ProcessLookupError, PermissionError):
         pass
+
+
+def _kill_group(process):
+    _signal_group(process)
     process.stderr.close()
     process.wait()

@@ -14,6 +14,7 @@ from collections import deque
 from concurrent.futures import ThreadPoolExecutor
 
 from ..plan import make_plan
+from .filtering import stop_filter_commands
 from .planner import PlannerProcesses
 from .work import compute, prepare, store
 
@@ -91,6 +92,8 @@ def run_local(jobs, settings, engine, *, workers=None, progress=None, started=No
         except BaseException:
             # Ctrl+C or a failing callback: nothing new starts; images being written finish
             # (every write is atomic either way) and their scratch folders are removed.
+            # Filter commands run in process groups of their own, out of the terminal's reach.
+            stop_filter_commands()
             for _, future in prepared:
                 if not future.cancel():
                     _discard(future)
