@@ -130,3 +130,28 @@ def test_the_analysis_window_is_the_one_with_most_edges_and_spans_the_image():
     reads = []
     sample = analysis_sample(lambda r, c: reads.append((r, c)) or flat[r, c], lambda r, c: flat[r, c], height, width)
     assert reads[-1] == windows[0] and sample[0].shape == (512, 512)
+
+
+def test_a_long_streamed_write_keeps_its_part_while_another_run_tidies_the_folder(tmp_path):
+    """A gigapixel write takes minutes; a batch or recover beside it removes stale parts of
+    writers that are gone. The streamed writer's part is locked, so it is not taken for one."""
+    import time
+
+    from aarecovery.io.parts import is_part_name, remove_stale_parts
+    image = random_image((64, 48, 3), np.uint8)
+    removed = []
+
+    def pieces():
+        for top in range(0, 64, 16):
+            for left in range(0, 48, 16):
+                if (top, left) == (32, 0):
+                    (part,) = [p for p in tmp_path.iterdir() if is_part_name(p.name)]
+                    old = time.time() - 3600  # older than any age rule
+                    os.utime(part, (old, old))
+                    removed.extend(remove_stale_parts(tmp_path))
+                yield image[top:top + 16, left:left + 16]
+
+    TiledTiffWriter(tmp_path / "r.tif", image.shape, image.dtype, 16).write(pieces())
+    assert removed == []
+    np.testing.assert_array_equal(read_image(tmp_path / "r.tif"), image)
+    assert [p.name for p in tmp_path.iterdir()] == ["r.tif"]
