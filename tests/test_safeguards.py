@@ -128,3 +128,17 @@ def test_an_affine_filter_in_the_blend_space_keeps_f():
     plan = analyse(rgba(original), rgba(filtered))
     assert plan.strength == 0 and "affine" in plan.reason
     np.testing.assert_array_equal(aarecovery.recover(original, filtered, backend="numpy"), filtered)
+
+
+@pytest.mark.parametrize("scene", ["shapes", "lines"])
+def test_repair_to_error_ratio_weighs_the_repair_against_the_models_error(scene):
+    """Under the identity filter every repair is the model's own error (ratio 1); under a
+    threshold the repairs dwarf it."""
+    from aarecovery.plan.model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
+    from aarecovery.params import SIGMA_D, SIGMA_E
+    case = make_case(_scenes.render(scene, 64, 4), "threshold", 4, "linear")
+    sigmas = dict(linear_input=False, blend_space="linear", sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default)
+    identity = repair_to_error_ratio(rgba(case.original), rgba(case.original), **sigmas)
+    thresholded = repair_to_error_ratio(rgba(case.original), rgba(case.filtered), **sigmas)
+    assert identity == pytest.approx(1.0, abs=1e-3)
+    assert thresholded > 50 * MIN_REPAIR_TO_ERROR

@@ -14,7 +14,9 @@ so ``mode="safe"`` first looks at the pair as a whole and decides, in this order
    (``pure_colours``); textured content (a photo) gets the strength that
    self-calibration at half resolution finds safe (``calibration``).
 4. **Other filters on textured images**: no way to simulate the filter and texture the
-   model would flatten: F is kept. On hard-edged content the paper's passes run.
+   model would flatten: F is kept. On hard-edged content the paper's passes run, unless
+   the repairs they would make are no larger than the model's own error carried through
+   the filter (``model_error``): then F is kept.
 
 All of it runs once, in NumPy, on a central crop, before tiling, and results in a
 :class:`PairAnalysis` that ``aarecovery.plan.make_plan`` turns into the backends' Plan.
@@ -30,6 +32,7 @@ from .blend_space import choose_blend_space
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
+from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import pure_colour_prior
 from .texture import is_textured
@@ -143,4 +146,11 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         return PairAnalysis(space, _PHOTO_NEIGHBOURHOOD_STRENGTH,
                             f"neighbourhood filter on a textured image ({texture}): "
                             f"strength {_PHOTO_NEIGHBOURHOOD_STRENGTH:g}")
-    return PairAnalysis(space, 1.0, "neighbourhood filter on hard-edged content: full strength")
+    ratio = repair_to_error_ratio(o_rgba, f_rgba, linear_input=linear_input, blend_space=space, sigma_d=sigma_d,
+                                  sigma_e=sigma_e)
+    if ratio < MIN_REPAIR_TO_ERROR:
+        return PairAnalysis(space, 0.0, f"neighbourhood filter on hard-edged content, but the repairs would be "
+                                        f"no larger than the model's own error (ratio {ratio:.2f} < "
+                                        f"{MIN_REPAIR_TO_ERROR:g}): kept F")
+    return PairAnalysis(space, 1.0, f"neighbourhood filter on hard-edged content (repair-to-error ratio "
+                                    f"{ratio:.1f}): full strength")

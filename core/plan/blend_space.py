@@ -13,7 +13,7 @@ from ..params import BLEND_SPACES, SIGMA_D, SIGMA_E
 from ..spec import fit_blend_model, to_working_space
 from ..spec.neighbourhood import neighbours, planes
 
-__all__ = ["choose_blend_space", "colour_line_residual"]
+__all__ = ["choose_blend_space", "colour_line_residual", "sampled_rows"]
 
 # The blend-space test fits the model on up to this many pixels of the crop (all of a
 # 256 x 256 crop; strips around every twelfth row of a 512 x 512 one): its mean residual
@@ -28,7 +28,7 @@ _SPACE_RATIO = 1.5
 _SPACE_MARGIN = 0.003
 
 
-def _sampled_rows(image, limit=_FIT_SAMPLE):
+def sampled_rows(image, limit=_FIT_SAMPLE):
     """At most about `limit` pixels of `image` as stacked 3-row strips, and their middle rows.
 
     The fit reads a 3x3 neighbourhood, so a strip of three rows gives its middle row exactly
@@ -58,7 +58,7 @@ def colour_line_residual(rgba, linear_input, blend_space):
     float or None
         None where fewer than 16 such pixels were found.
     """
-    work, middle = _sampled_rows(to_working_space(rgba, linear_input=linear_input, blend_space=blend_space))
+    work, middle = sampled_rows(to_working_space(rgba, linear_input=linear_input, blend_space=blend_space))
     model = fit_blend_model(work, work, SIGMA_D.default, SIGMA_E.default)
     colours = np.stack(neighbours(planes(work)))
     c_a = np.take_along_axis(colours, model.index_a[None, None].astype(np.intp), 0)[0]
