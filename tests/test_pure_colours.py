@@ -161,3 +161,28 @@ def test_a_smooth_gradient_keeps_f_and_a_one_ulp_change_of_o_changes_nothing(bac
     smooth = f_flat & o_smooth
     assert smooth.sum() > 500
     np.testing.assert_array_equal(results[0][smooth], filtered[smooth])
+
+
+def test_thin_features_are_not_extended_to_the_cube_when_f_is_straight_in_the_key():
+    """Colour to grey by luma is a straight function of the luma key: the cube extension's
+    guessed inks could only add error. A threshold of the same luma bends: it extends."""
+    from aarecovery.colour import luma
+    from aarecovery.lab import realtools
+    from aarecovery.plan.pointwise import fit_pointwise
+    from aarecovery.plan.pure_colours import STRAIGHT_TABLE_MISS, affine_in_key_miss, pure_colour_prior
+    from aarecovery.plan.resample import box_downsample
+    from aarecovery.spec.sobel import gradient_magnitude
+    scene = realtools.render_family("starburst", 64)
+    original = np.rint(box_downsample(scene, realtools.FAMILIES["starburst"].k, "srgb") * 255) / np.float32(255)
+    edges = gradient_magnitude(original) >= 0.02
+    grey = np.repeat(luma(original)[..., None], 3, axis=-1).astype(np.float32)
+    thresholded = np.repeat((luma(original) >= 0.5)[..., None], 3, axis=-1).astype(np.float32)
+    assert affine_in_key_miss(original, grey, edges, "luma") < 1e-4
+    assert affine_in_key_miss(original, thresholded, edges, "luma") > 5 * STRAIGHT_TABLE_MISS
+    priors = {}
+    for name, filtered in (("grey", grey), ("threshold", thresholded)):
+        transfer = fit_pointwise(original, filtered, edges)
+        priors[name] = pure_colour_prior(original, transfer, "srgb", filtered, edges)
+        assert priors[name] is not None and priors[name].key in ("luma", "luminance", "luminance_d50", "channel")
+    assert not priors["grey"].to_cube
+    assert priors["threshold"].to_cube

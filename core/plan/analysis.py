@@ -133,7 +133,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # With a monotone per-channel or luma table, thin features get their pure colours:
         # quick suite 0.600 -> 0.712 (linear), 0.628 -> 0.686 (sRGB); the table's ends
         # extended by a power law: 0.774 / 0.734.
-        prior = pure_colour_prior(o, transfer, space)
+        prior = pure_colour_prior(o, transfer, space, f, edges)
         return PairAnalysis(space, 1.0, f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges "
                                         "match) on hard-edged content: full strength"
                                         + (", pure colours of thin features" if prior is not None else ""), prior)

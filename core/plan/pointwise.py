@@ -12,7 +12,7 @@ import numpy as np
 from ..colour import LUMA, luma, srgb_to_linear
 from ..spec.pure_colours import LUMINANCE_KEYS, SCALE_KEYS, key_values, scale_transfer
 
-__all__ = ["PointwiseTransfer", "fit_pointwise", "filled_bins", "POINTWISE_SHARE"]
+__all__ = ["PointwiseTransfer", "fit_pointwise", "filled_bins", "key_of", "POINTWISE_SHARE", "TABLE_KEYS"]
 
 # Point-wise fit: bins of the table, tolerance of a match and the share of edge pixels that
 # must match. Point-wise filters of the suite score >= 0.99; neighbourhood filters <= 0.8.
@@ -26,7 +26,7 @@ POINTWISE_SHARE = 0.97
 TABLE_KEYS = ("channel", "luma", "mean", "max") + tuple(LUMINANCE_KEYS)
 
 
-def _key(colour, key):
+def key_of(colour, key):
     """The values of `key` for encoded colour ``(..., 3)``: shape (..., 3) for "channel", else (...)."""
     if key == "channel":
         return colour
@@ -66,7 +66,7 @@ class PointwiseTransfer:
         if self.key in SCALE_KEYS:
             planes = np.ascontiguousarray(colour.reshape(-1, 3).T, dtype=np.float32)
             return scale_transfer(planes, self.key, self.table).T.reshape(colour.shape)
-        values = _key(colour, self.key)
+        values = key_of(colour, self.key)
         index = _bins(values)
         if self.key == "channel":
             return np.stack([self.table[index[..., c], c] for c in range(3)], axis=-1)
@@ -103,7 +103,7 @@ def fit_pointwise(original, filtered, edges):
         return float((miss <= _LUT_TOLERANCE).mean())
 
     for key in TABLE_KEYS:
-        values = _key(original, key)
+        values = key_of(original, key)
         index = _bins(values)
         table = np.empty((_LUT_BINS, 3), np.float32)
         for c in range(3):
