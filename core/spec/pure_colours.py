@@ -135,7 +135,9 @@ class PureColourPrior:
     to_cube : bool
         Extend a partial colour to the colour cube when no flat colour of O lies beyond it on
         its line. False where the fitted tables that explain F equally well disagree on the
-        cube (two colours fit any key), so that f there is a guess.
+        cube (two colours fit any key), so that f there is a guess, and where F is an affine
+        function of the table's key on O's edges (``aarecovery.plan.pure_colours``), so
+        that the guess could only add its own error.
     """
 
     key: str
