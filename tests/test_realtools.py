@@ -291,11 +291,28 @@ def test_colour_to_grey_of_a_star_burst_is_not_made_worse():
     assert error(result) < 0.9 * error(case.filtered), engine.last_plan.reason
 
 
+@pytest.mark.parametrize("family", ["rocket", "chelsea"])
+def test_a_palette_quantiser_of_a_photo_is_repaired(family):
+    """G'MIC's ``-quantize 4`` maps each colour to the nearest of four: a point-wise map of
+    the whole colour that no one-channel table fits. It was kept as F on colour photos
+    (strength 0); as a calibrated colour map R gains on the edge band."""
+    import aarecovery
+    from aarecovery.lab.metrics import edge_band, error_reduction
+    require_tool("gmic")
+    suite = realtools.RealToolsSuite("quantize", (family,), ("gmic-quantize",), 96, {family: ("linear",)})
+    (case,) = realtools.build_cases(suite, "heldout", jpeg=False)
+    engine = aarecovery.Engine("numpy")
+    result = aarecovery.recover(case.original, case.filtered, engine=engine)
+    assert engine.last_plan.reason.startswith("point-wise colour map"), engine.last_plan.reason
+    band = edge_band(case.original, case.filtered, case.reference)
+    assert error_reduction(result, case.filtered, case.reference, band) > 0.1, engine.last_plan.reason
+
+
 def test_safe_default_on_the_held_out_quick_suite():
     """What the safe default achieves on images and tools it was not tuned on (docs/quality.md).
 
     Issue 10's never-worse target holds here and is asserted as stated; the other figures are
-    floors a little under today's (0.56, 0.21 and 0.40 on this suite), short of the issue's
+    floors a little under today's (0.56, 0.24 and 0.43 on this suite), short of the issue's
     targets (0.75, 0.3 and 0.8), so that a change that loses ground fails.
     """
     from aarecovery.lab.realeval import MAX_LOSS_DB
@@ -310,5 +327,5 @@ def test_safe_default_on_the_held_out_quick_suite():
     # GEGL's bilateral filter is the one filter where a peer (the joint bilateral filter) does
     # better on this half; on every other filter R is ahead of each peer.
     assert set(summary["behind_peers"]) <= {"gegl-bilateral"}, summary["behind_peers"]
-    assert summary["photo_pointwise"]["R"] >= 0.18, summary["photo_pointwise"]
+    assert summary["photo_pointwise"]["R"] >= 0.22, summary["photo_pointwise"]
     assert summary["jpeg_gain_kept"]["q>=85"]["R"][0] >= 0.35, summary["jpeg_gain_kept"]["q>=85"]

@@ -1,0 +1,82 @@
+"""The 3-D colour-map fit (``aarecovery.plan.colour_map``): palette quantisers are found,
+neighbourhood filters are not, and the table reproduces the map where O has samples."""
+
+import numpy as np
+
+from aarecovery.plan.analysis import analyse
+from aarecovery.plan.calibration import EDGE_GRADIENT
+from aarecovery.plan.colour_map import COLOUR_MAP_SHARE, fit_colour_map
+from aarecovery.spec.sobel import gradient_magnitude
+
+
+def _photo_like(size=128, seed=0):
+    """Smooth colour fields with soft-edged blobs and sensor grain: textured, many colours."""
+    rng = np.random.default_rng(seed)
+    y, x = np.mgrid[0:size, 0:size] / size
+    image = np.stack([0.2 + 0.6 * x, 0.3 + 0.4 * y, 0.5 + 0.3 * np.sin(6 * x + 3 * y)], axis=-1)
+    for _ in range(12):
+        cy, cx, radius = rng.uniform(0, 1, 2).tolist() + [rng.uniform(0.05, 0.2)]
+        inside = np.clip((radius - np.hypot(y - cy, x - cx)) * size / 1.5, 0, 1)[..., None]
+        image = image * (1 - inside) + rng.uniform(0, 1, 3) * inside
+    image = image + rng.normal(0, 3 / 255, image.shape)
+    return np.clip(np.round(image * 255) / 255, 0, 1).astype(np.float32)
+
+
+def _quantise(image, palette):
+    distance = ((image[..., None, :] - palette) ** 2).sum(axis=-1)
+    return palette[np.argmin(distance, axis=-1)].astype(np.float32)
+
+
+def _box3(image):
+    padded = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    height, width = image.shape[:2]
+    return sum(padded[dy:dy + height, dx:dx + width] for dy in range(3) for dx in range(3)) / 9
+
+
+PALETTE = np.array([[0.1, 0.1, 0.2], [0.8, 0.3, 0.2], [0.3, 0.7, 0.4], [0.9, 0.9, 0.7]], np.float32)
+
+
+def test_a_palette_quantiser_is_a_colour_map():
+    original = _photo_like()
+    filtered = _quantise(original, PALETTE)
+    edges = gradient_magnitude(original) >= EDGE_GRADIENT
+    fitted = fit_colour_map(original, filtered, edges)
+    assert fitted.consistency >= COLOUR_MAP_SHARE
+    # Away from the palette's boundaries the table gives the quantiser's colour.
+    distances = np.sort(((original[..., None, :] - PALETTE) ** 2).sum(axis=-1), axis=-1)
+    clear = np.sqrt(distances[..., 1]) - np.sqrt(distances[..., 0]) > 0.2
+    assert np.abs(fitted(original)[clear] - filtered[clear]).max() < 2 / 255
+
+
+def test_neighbourhood_filters_are_not_colour_maps():
+    original = _photo_like()
+    edges = gradient_magnitude(original) >= EDGE_GRADIENT
+    blurred = _box3(original)
+    sharpened = np.clip(original + 1.5 * (original - blurred), 0, 1)
+    for filtered in (blurred, sharpened):
+        assert fit_colour_map(original, filtered.astype(np.float32), edges).consistency < COLOUR_MAP_SHARE
+
+
+def test_one_pixel_per_bin_proves_nothing():
+    """Each edge pixel is left out of its own bin: pixels alone in theirs are not counted."""
+    rng = np.random.default_rng(1)
+    original = rng.uniform(0, 1, (8, 8, 3)).astype(np.float32)
+    filtered = rng.uniform(0, 1, (8, 8, 3)).astype(np.float32)
+    assert fit_colour_map(original, filtered, np.ones((8, 8), bool)).consistency < COLOUR_MAP_SHARE
+
+
+def test_empty_bins_take_their_neighbours_colour():
+    original = np.full((16, 16, 3), 0.5, np.float32)
+    filtered = np.full((16, 16, 3), 0.25, np.float32)
+    fitted = fit_colour_map(original, filtered, np.ones((16, 16), bool))
+    far = np.array([[0.0, 1.0, 0.0], [1.0, 1.0, 1.0]], np.float32)
+    assert np.allclose(fitted(far), 0.25, atol=1e-6)
+
+
+def test_safe_plan_calibrates_a_palette_quantiser_of_a_photo():
+    original = _photo_like(seed=2)
+    filtered = _quantise(original, PALETTE)
+    opaque = np.ones(original.shape[:2] + (1,), np.float32)
+    analysis = analyse(np.concatenate([original, opaque], -1), np.concatenate([filtered, opaque], -1))
+    assert analysis.reason.startswith("point-wise colour map"), analysis.reason
+    assert "calibration chose strength" in analysis.reason
