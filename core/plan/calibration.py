@@ -22,6 +22,11 @@ EDGE_GRADIENT = 0.02
 # strength must show at half resolution to be chosen over leaving F alone.
 _STRENGTHS = (0.0, 0.25, 0.5, 1.0)
 _MIN_GAIN = 0.01
+# After the grid, one more strength halfway between the best and its better neighbour: the
+# half-resolution error is smooth in the strength. Measured on the real-tools suite's tuning
+# half: photos under point-wise filters 0.295 -> 0.304, JPEG gain kept 0.25 -> 0.27, no new
+# loss, for one more half-size recovery (+0.07 s on a 512 x 512 crop); the whole grid of
+# eighths gave the same figures for four more.
 
 
 def calibrate_strength(original, transfer, filtered, space, sigma_d, sigma_e, iterations):
@@ -41,7 +46,8 @@ def calibrate_strength(original, transfer, filtered, space, sigma_d, sigma_e, it
     Returns
     -------
     strength : float
-        One of the candidate strengths; 0 unless a non-zero one gains 1 % MSE.
+        One of the candidate strengths (0, 0.25, 0.5, 1 and one halfway between the best of
+        those and its better neighbour); 0 unless a non-zero one gains 1 % MSE.
     errors : dict of float to float
         The half-resolution MSE of each candidate.
     """
@@ -59,14 +65,21 @@ def calibrate_strength(original, transfer, filtered, space, sigma_d, sigma_e, it
     band = (np.abs(f2 - target).max(axis=-1) > 1 / 255) | (gradient.max() > 0) & (gradient >= EDGE_GRADIENT)
     if not band.any():
         return 1.0, {}
-    errors = {}
-    for strength in _STRENGTHS:
+
+    def error_at(strength):
         if strength == 0:
             result = f2
         else:
             recovered, _ = recover_working(work_o, work_f, sigma_d, sigma_e, iterations, strength)
             result = from_working_space(recovered, f2_rgba, blend_space=space)[..., :3]
-        errors[strength] = float(np.mean(np.square(result - target)[band]))
+        return float(np.mean(np.square(result - target)[band]))
+
+    errors = {strength: error_at(strength) for strength in _STRENGTHS}
+    ordered = list(_STRENGTHS)
+    best = ordered.index(min(errors, key=errors.get))
+    closer = min((ordered[i] for i in (best - 1, best + 1) if 0 <= i < len(ordered)), key=errors.get)
+    halfway = (ordered[best] + closer) / 2
+    errors[halfway] = error_at(halfway)
     base = errors[0.0]
     best = min(errors, key=errors.get)
     if best != 0.0 and errors[best] > base * (1 - _MIN_GAIN):
