@@ -153,7 +153,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                 f"strength {_PHOTO_NEIGHBOURHOOD_STRENGTH:g}")
         # A colour map that bends colours smoothly (a hue change) leaves repairs no larger
         # than the model's error; calibration alone chose 0.5 there and lost 0.73 dB (GEGL's
-        # hue-chroma on maps, quick tuning half: ratio 1.18). Palette quantisers score 17-75.
+        # hue-chroma on maps, quick tuning half: ratio 1.18); the held-out quantised photos
+        # score 17-75.
         ratio = _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e)
         if ratio < MIN_REPAIR_TO_ERROR:
             return PairAnalysis(space, 0.0, f"point-wise colour map ({colour_map.consistency:.3f} of edges match) on "

@@ -18,8 +18,9 @@ import numpy as np
 
 __all__ = ["ColourMapTransfer", "fit_colour_map", "COLOUR_MAP_SHARE"]
 
-# Bins per channel: 8/255 wide. Finer bins leave most edge pixels alone in their bin on a
-# 512 x 512 crop; coarser ones straddle a quantiser's boundaries.
+# Bins per channel: 8/255 wide, not swept. Finer bins hold fewer pixels each to leave one out
+# of (a 512 x 512 crop has 8 pixels per bin of 32^3 on average); coarser ones straddle more
+# of a quantiser's boundaries.
 _BINS = 32
 _MATCH = 3.0 / 255
 #: Share of O's edge pixels (left out of their own bin) that the 3-D table must match within
@@ -35,7 +36,8 @@ class ColourMapTransfer:
     Attributes
     ----------
     key : str
-        ``"colour"`` (the whole colour indexes the table), for messages.
+        ``"colour"``: the whole colour indexes the table (``PointwiseTransfer.key`` names
+        its single key the same way).
     table : ndarray of float32, shape (32, 32, 32, 3)
         Output colour per bin of (R, G, B).
     consistency : float
