@@ -122,3 +122,21 @@ def test_generated_block_has_the_form_the_report_writes(command, tmp_path, capsy
     written = _GENERATED.fullmatch((tmp_path / "tables.md").read_text(encoding="utf-8").rstrip("\n"))
     assert written and written["command"] == command
     assert _skeleton(written.group(0)) == _skeleton(documented.group(0))
+
+
+def _slug(heading):
+    """The anchor GitHub gives a heading: lower case, punctuation dropped, spaces to hyphens."""
+    return re.sub(r"[^\w\- ]", "", heading.strip().lower()).replace(" ", "-")
+
+
+def test_links_between_the_guides_resolve():
+    broken = []
+    for page in [CHECKOUT / "README.md", *sorted((CHECKOUT / "docs").glob("*.md"))]:
+        for target, anchor in re.findall(r"\]\(([\w./-]+\.md)(?:#([\w-]+))?\)", page.read_text(encoding="utf-8")):
+            linked = (page.parent / target).resolve()
+            if not linked.exists():
+                broken.append(f"{page.name}: {target}")
+            elif anchor and anchor not in {_slug(h) for h in re.findall(r"^#+ (.+)$", linked.read_text(
+                    encoding="utf-8"), re.M)}:
+                broken.append(f"{page.name}: {target}#{anchor}")
+    assert not broken, f"links to missing pages or headings: {broken}"
