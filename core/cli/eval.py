@@ -37,7 +37,8 @@ def register(subparsers):
     parser.add_argument("--backend", choices=BACKENDS, default="numpy",
                         help="recovery backend (default numpy, the specification)")
     parser.add_argument("--no-peers", action="store_true", help="skip GIMP and G'MIC")
-    parser.add_argument("--report", metavar="DIR", help="also write DIR/report.md with charts and crops")
+    parser.add_argument("--report", metavar="DIR", help="also write DIR/report.md with charts and crops, and "
+                                                         "DIR/tables.md, the Markdown tables docs/quality.md includes")
     parser.set_defaults(run=run)
 
 

@@ -6,11 +6,13 @@ import numpy as np
 
 from .realeval import (JPEG_TARGET_QUALITY, MAX_LOSS_DB, METHODS, MIN_HARD_REDUCTION, MIN_JPEG_GAIN_KEPT,
                        MIN_PHOTO_POINTWISE_REDUCTION, mean_reductions, summarize_realtools)
+from .report import TABLES_FILE, generated_block, markdown_table
 
-__all__ = ["format_realtools", "write_realtools_report", "WORST_SHOWN"]
+__all__ = ["format_realtools", "realtools_markdown_tables", "write_realtools_report", "WORST_SHOWN"]
 
 #: How many of the safe default's worst cases the summary lists.
 WORST_SHOWN = 15
+_HALF_NAMES = {"tune": "tuning", "heldout": "held-out", "all": "every"}
 _HELD_OUT_WARNING = ("!! HELD-OUT HALF: report these numbers; choose no threshold, constant or rule by them "
                      "(tune on --half tune)")
 
@@ -105,6 +107,74 @@ def _target_lines(results, summary):
     return lines
 
 
+def _target_rows(results, summary):
+    """(target, R, the others, limit, met) for each of the issue's targets."""
+    methods = [m for m in METHODS[1:] if m in summary["hard"]]
+
+    def others(values):
+        return ", ".join(f"{m} {_reduction(values[m]).strip()}" for m in methods if m != "R" and m in values)
+
+    def met(ok):
+        return "yes" if ok else "**no**"
+
+    loss, where = summary["worst_loss_db"]
+    over = summary["losses_over_limit"]
+    rows = [(f"1. never worse than F by more than {MAX_LOSS_DB} dB", f"worst loss {loss:+.2f} dB ({where}); {over} of "
+             f"{len(results)} cases over", "", "0 cases", met(over == 0))]
+    hard = summary["hard"]
+    rows.append((f"2. drawings, PNG originals: mean error reduction ({summary['hard_cases']} cases)",
+                 _reduction(hard.get("R", np.nan)).strip(), others(hard), f"{MIN_HARD_REDUCTION}",
+                 met(hard.get("R", -np.inf) >= MIN_HARD_REDUCTION)))
+    behind = summary["behind_peers"]
+    rows.append(("2. R ahead of every peer on every filter (drawings, PNG)",
+                 "every filter" if not behind else "behind on " + ", ".join(behind), "", "every filter",
+                 met(not behind)))
+    label = f"q>={JPEG_TARGET_QUALITY}"
+    if label in summary["jpeg_gain_kept"]:
+        kept = summary["jpeg_gain_kept"][label]
+        value, pairs = kept.get("R", (np.nan, 0))
+        rows.append((f"3. JPEG originals ({label}): share of R's PNG gain kept ({pairs} pairs)", f"{value:.2f}",
+                     f"paper {kept.get('paper', (np.nan, 0))[0]:.2f}", f"{MIN_JPEG_GAIN_KEPT}",
+                     met(value >= MIN_JPEG_GAIN_KEPT)))
+    photo = summary["photo_pointwise"]
+    rows.append((f"4. photos under point-wise filters, PNG: mean error reduction "
+                 f"({summary['photo_pointwise_cases']} cases)", _reduction(photo.get("R", np.nan)).strip(),
+                 others(photo), f"{MIN_PHOTO_POINTWISE_REDUCTION}",
+                 met(photo.get("R", -np.inf) >= MIN_PHOTO_POINTWISE_REDUCTION)))
+    outside = summary["outside"]
+    pixels, cases = outside.get("R", (0, 0))
+    rows.append(("5. R pixels outside F's 3 x 3 colour range", f"{pixels} in {cases} cases",
+                 ", ".join(f"{m} {outside[m][0]}" for m in outside if m != "R"), "0", met(pixels == 0)))
+    return rows
+
+
+def realtools_markdown_tables(results, missing_tools=(), missing_peers=(), *, suite_name="realtools", half="tune",
+                              command="aarecovery eval --suite realtools"):
+    """The Markdown tables that docs/quality.md includes for one half: the issue's targets and
+    the mean error reduction per group of filters, in a block marked with its command."""
+    methods = _present(results)
+    reduced = methods[1:]
+    png = sum(1 for r in results if r.quality is None)
+    lines = [f"Real-tools suite {suite_name!r}, {_HALF_NAMES.get(half, half)} half: {len(results)} "
+             f"cases ({png} PNG, {len(results) - png} JPEG)"
+             + "".join(f"; **{item.label} was not installed**" for item in (*missing_tools, *missing_peers))
+             + ".", ""]
+    summary = summarize_realtools(results)
+    lines += markdown_table(("target", "R", "others", "limit", "met"), _target_rows(results, summary)) + [""]
+    lines += [f"Mean edge-band error reduction per group of filters (PNG cases where F has an error), the cases "
+              f"where R loses more than {MAX_LOSS_DB} dB against F, and R's worst loss (every case; below 0, the "
+              "least gain):", ""]
+    rows = []
+    for group in dict.fromkeys(r.group for r in results):
+        mine = [r for r in results if r.group == group]
+        means, count = mean_reductions([r for r in mine if r.quality is None])
+        losses = [r.psnr_band["F"] - r.psnr_band["R"] for r in mine]
+        rows.append((group, count) + tuple(_reduction(means.get(m, np.nan)).strip() for m in reduced)
+                    + (sum(1 for x in losses if x > MAX_LOSS_DB), f"{max(losses):+.2f}"))
+    lines += markdown_table(("group", "n") + tuple(reduced) + ("losses", "worst loss dB"), rows)
+    return generated_block(command, "\n".join(lines))
+
+
 def format_realtools(results, missing_tools=(), missing_peers=(), *, suite_name="realtools", half="tune"):
     """Plain-text report of a real-tools run: what ``aarecovery eval --suite realtools`` prints."""
     methods = _present(results)
@@ -143,7 +213,9 @@ def format_realtools(results, missing_tools=(), missing_peers=(), *, suite_name=
 
 def write_realtools_report(results, folder, missing_tools=(), missing_peers=(), *, suite_name="realtools",
                            half="tune", command="aarecovery eval --suite realtools"):
-    """Write ``report.md``: the text report and magnified crops of the safe default's worst cases.
+    """Write ``report.md``, the text report and magnified crops of the safe default's worst cases,
+    and ``tables.md``, the Markdown tables that docs/quality.md includes
+    (:func:`realtools_markdown_tables`).
 
     Parameters
     ----------
@@ -161,6 +233,9 @@ def write_realtools_report(results, folder, missing_tools=(), missing_peers=(), 
 
     from .report import _crop_strip
     os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, TABLES_FILE), "w", encoding="utf-8") as handle:
+        handle.write(realtools_markdown_tables(results, missing_tools, missing_peers, suite_name=suite_name,
+                                               half=half, command=command))
     lines = ["# aarecovery evaluation: real tools", "", f"Command: `{command}`", "", "```",
              format_realtools(results, missing_tools, missing_peers, suite_name=suite_name, half=half), "```", ""]
     worst = sorted(results, key=lambda r: r.psnr_band["R"] - r.psnr_band["F"])[:8]

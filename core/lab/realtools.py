@@ -135,7 +135,7 @@ def _tf(name, tool, arguments, group, half, lengths=None, reach=0.0, whole_image
     return ToolFilter(name, tool, tuple(arguments), group, half, dict(lengths or {}), reach, whole_image)
 
 
-# The operations and their conventions are in docs/quality.md ("How real tools work").
+# The operations and their conventions are in docs/real-tools.md.
 TOOL_FILTERS = {f.name: f for f in (
     # Tuning half.
     _tf("gegl-threshold", "gegl", ["gegl:threshold", "value=0.5"], "threshold", "tune"),
