@@ -4,8 +4,10 @@ import os
 
 import numpy as np
 
+from .metrics import HAZE_TOLERANCE
 from .realeval import (JPEG_TARGET_QUALITY, MAX_LOSS_DB, METHODS, MIN_HARD_REDUCTION, MIN_JPEG_GAIN_KEPT,
-                       MIN_PHOTO_POINTWISE_REDUCTION, mean_reductions, summarize_realtools)
+                       MIN_MIXED_REDUCTION, MIN_NEIGHBOURHOOD_REDUCTION, MIN_PHOTO_POINTWISE_REDUCTION,
+                       MIN_TEXT_REDUCTION, REGIONS, mean_reductions, summarize_mixed, summarize_realtools)
 
 __all__ = ["format_realtools", "write_realtools_report", "WORST_SHOWN"]
 
@@ -105,6 +107,67 @@ def _target_lines(results, summary):
     return lines
 
 
+def _means(values, skip=()):
+    return ", ".join(f"{m} {_reduction(v).strip()}" for m, v in values.items() if m not in skip)
+
+
+def _issue19_lines(results, summary):
+    lines = ["", "== targets of issue 19 (asserted on the held-out half once met)"]
+    mixed = summary["mixed"]
+    text, photo = (mixed[region] for region in REGIONS)
+    if text[1] or photo[1]:
+        lines.append(f"mixed content, text/graphics regions' edge band, PNG originals ({text[1]} cases): "
+                     f"R {_reduction(text[0].get('R', np.nan)).strip()} ({_means(text[0], ('R',))}); target "
+                     f"{MIN_TEXT_REDUCTION}: {_verdict(text[0].get('R', -np.inf) >= MIN_TEXT_REDUCTION)}; "
+                     f"{len(text[2])} cases worse than F")
+        lines.append(f"mixed content, photo regions' edge band ({photo[1]} cases): R "
+                     f"{_reduction(photo[0].get('R', np.nan)).strip()} ({_means(photo[0], ('R',))}); target: at "
+                     f"least the calibrated strength of today's plan, no region worse than F: {len(photo[2])} cases "
+                     f"worse" + (f" ({', '.join(photo[2][:4])})" if photo[2] else ""))
+        overall, cases = mixed["overall"]
+        lines.append(f"mixed content, whole edge band ({cases} cases): R {_reduction(overall.get('R', np.nan)).strip()} "
+                     f"({_means(overall, ('R',))}); target {MIN_MIXED_REDUCTION}: "
+                     f"{_verdict(overall.get('R', -np.inf) >= MIN_MIXED_REDUCTION)}")
+    if summary["neighbourhood_cases"]:
+        near = summary["neighbourhood"]
+        loss, where = summary["neighbourhood_worst_db"]
+        lines.append(f"neighbourhood filters (unsharp, bilateral, abstraction, detail) on hard-edged drawings, PNG "
+                     f"originals ({summary['neighbourhood_cases']} cases): R {_reduction(near.get('R', np.nan)).strip()}"
+                     f" ({_means(near, ('R',))}); target {MIN_NEIGHBOURHOOD_REDUCTION}: "
+                     f"{_verdict(near.get('R', -np.inf) >= MIN_NEIGHBOURHOOD_REDUCTION)}; worst loss to F "
+                     f"{loss:+.2f} dB ({where})")
+    haze = summary["haze"]
+    if haze:
+        parts = []
+        for label, values in haze.items():
+            counts = ", ".join(f"{m} {values[m][0]} px in {values[m][1]}" for m in ("R", "paper", "jbf") if m in values)
+            parts.append(f"{label} ({values['R'][2]} cases, {values['paper_pixels']} paper px): {counts}")
+        lines.append(f"scans: haze, paper pixels made darker than F by more than {HAZE_TOLERANCE * 255:g}/255 in luma; "
+                     f"target 0 (F has none by definition): " + "; ".join(parts))
+    return lines
+
+
+def _mixed_lines(results):
+    mixed = [r for r in results if r.kind == "mixed" and r.quality is None]
+    if not mixed:
+        return []
+    lines = ["", "== mixed content per family: mean edge-band error reduction per region, PNG cases where F has an "
+                 "error there (n)",
+             f"{'family':14s} " + " ".join(f"{region + ' R':>17s} {'paper':>7s} {'n':>3s}" for region in REGIONS)
+             + f" {'overall R':>10s} {'paper':>7s}"]
+    for family in dict.fromkeys(r.scene for r in mixed):
+        summary = summarize_mixed([r for r in mixed if r.scene == family])
+        cells = []
+        for region in REGIONS:
+            means, count, _ = summary[region]
+            cells.append(f"{_reduction(means.get('R', np.nan)):>17s} {_reduction(means.get('paper', np.nan))} "
+                         f"{count:3d}")
+        overall = summary["overall"][0]
+        lines.append(f"{family:14s} " + " ".join(cells) + f" {_reduction(overall.get('R', np.nan)):>10s} "
+                     f"{_reduction(overall.get('paper', np.nan))}")
+    return lines
+
+
 def format_realtools(results, missing_tools=(), missing_peers=(), *, suite_name="realtools", half="tune"):
     """Plain-text report of a real-tools run: what ``aarecovery eval --suite realtools`` prints."""
     methods = _present(results)
@@ -115,8 +178,7 @@ def format_realtools(results, missing_tools=(), missing_peers=(), *, suite_name=
     if half != "tune":
         lines.append(_HELD_OUT_WARNING)
     for tool in missing_tools:
-        lines.append(f"!! {tool.label} is NOT installed (none of {', '.join(tool.commands)} found; Debian package "
-                     f"'{tool.package}'): its cases are missing")
+        lines.append(f"!! {tool.label} is NOT installed ({tool.install_hint()}): its cases are missing")
     for peer in missing_peers:
         lines.append(f"!! {peer.label} is NOT installed (`{peer.command}` not found; Debian package "
                      f"'{peer.package}'): its column is missing")
@@ -128,8 +190,10 @@ def format_realtools(results, missing_tools=(), missing_peers=(), *, suite_name=
     lines += _group_lines(results, lambda r: r.group, "group", methods)
     lines += _group_lines(results, lambda r: r.scene, "family", methods)
     lines += _group_lines(results, lambda r: r.source, "source", methods, png_only=False)
+    lines += _mixed_lines(results)
     summary = summarize_realtools(results)
     lines += _target_lines(results, summary)
+    lines += _issue19_lines(results, summary)
     worst = sorted(results, key=lambda r: r.psnr_band["R"] - r.psnr_band["F"])[:WORST_SHOWN]
     lines += ["", f"== the {len(worst)} worst cases of the safe default (edge-band PSNR of R minus F)",
               f"{'case':44s} {'F':>6s} {'R':>6s} {'R-F dB':>7s} {'red R':>7s} {'chg%':>6s} {'max':>6s} "
