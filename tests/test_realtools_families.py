@@ -179,8 +179,11 @@ def test_summary_prints_regions_haze_and_neighbourhood_filters():
     assert summary["mixed"]["text/graphics"][1] > 0 and summary["neighbourhood_cases"] > 0
     assert "png" in summary["haze"] and "jpeg" in summary["haze"]
     table = format_realtools(results, half="heldout")
-    for line in ("mixed content, text/graphics regions' edge band", "mixed content, photo regions' edge band",
-                 "mixed content, whole edge band", "neighbourhood filters (unsharp, bilateral, abstraction, detail)",
-                 "scans: haze", "== mixed content per family"):
+    for line in ("mixed content under every filter, text/graphics regions' edge band",
+                 "mixed content under every filter, photo regions' edge band",
+                 "mixed content under point-wise filters, whole edge band",
+                 "neighbourhood filters (unsharp, bilateral, abstraction, detail)", "scans: haze,",
+                 "== mixed content per family", "== scans: haze per filter"):
         assert line in table, line
     assert "banner " in table.split("== mixed content per family")[1]
+    assert "im-threshold-55 " in table.split("== scans: haze per filter")[1]

@@ -250,7 +250,8 @@ def summarize_realtools(results):
         ``neighbourhood``: mean reductions on drawings with PNG originals under filters that
         read a neighbourhood, ``neighbourhood_cases`` and ``neighbourhood_worst_db`` (R's
         worst loss to F there, and the case);
-        ``mixed``: see :func:`summarize_mixed`; ``haze``: see :func:`summarize_haze`.
+        ``mixed``: see :func:`summarize_mixed`, and ``mixed_pointwise`` the same under
+        point-wise filters; ``haze``: see :func:`summarize_haze`.
     """
     from .realtools import NEIGHBOURHOOD_GROUPS, POINTWISE_GROUPS
     summary = {}
@@ -294,6 +295,8 @@ def summarize_realtools(results):
     summary["neighbourhood_worst_db"] = max(((r.psnr_band["F"] - r.psnr_band["R"], r.name) for r in neighbourhood),
                                             default=(0.0, ""))
     summary["mixed"] = summarize_mixed([r for r in png if r.kind == "mixed"])
+    # Issue 19 saw the split of one strength between text and photo under point-wise filters.
+    summary["mixed_pointwise"] = summarize_mixed([r for r in png if r.kind == "mixed" and r.group in POINTWISE_GROUPS])
     summary["haze"] = summarize_haze([r for r in results if r.kind == "scan"])
     return summary
 

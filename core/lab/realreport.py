@@ -111,23 +111,46 @@ def _means(values, skip=()):
     return ", ".join(f"{m} {_reduction(v).strip()}" for m, v in values.items() if m not in skip)
 
 
+def _mixed_target_lines(mixed, which):
+    text, photo = (mixed[region] for region in REGIONS)
+    if not (text[1] or photo[1]):
+        return []
+    overall, cases = mixed["overall"]
+    return [f"mixed content under {which}, text/graphics regions' edge band, PNG originals ({text[1]} cases): "
+            f"R {_reduction(text[0].get('R', np.nan)).strip()} ({_means(text[0], ('R',))}); target "
+            f"{MIN_TEXT_REDUCTION}: {_verdict(text[0].get('R', -np.inf) >= MIN_TEXT_REDUCTION)}; "
+            f"{len(text[2])} cases worse than F",
+            f"mixed content under {which}, photo regions' edge band ({photo[1]} cases): R "
+            f"{_reduction(photo[0].get('R', np.nan)).strip()} ({_means(photo[0], ('R',))}); target: at least "
+            f"the calibrated strength of today's plan, no region worse than F: {len(photo[2])} cases worse"
+            + (f" ({', '.join(photo[2][:4])})" if photo[2] else ""),
+            f"mixed content under {which}, whole edge band ({cases} cases): R "
+            f"{_reduction(overall.get('R', np.nan)).strip()} ({_means(overall, ('R',))}); target "
+            f"{MIN_MIXED_REDUCTION}: {_verdict(overall.get('R', -np.inf) >= MIN_MIXED_REDUCTION)}"]
+
+
+def _haze_lines(results):
+    scans = [r for r in results if r.kind == "scan"]
+    if not scans:
+        return []
+    lines = ["", f"== scans: haze per filter, paper pixels made darker than F by more than {HAZE_TOLERANCE * 255:g}/255 "
+                 "in luma (cases with any / cases)",
+             f"{'filter':26s} {'R png':>14s} {'paper png':>14s} {'R jpeg':>14s} {'paper jpeg':>14s}"]
+    for name in dict.fromkeys(r.filter_name for r in scans):
+        cells = []
+        for png in (True, False):
+            mine = [r for r in scans if r.filter_name == name and (r.quality is None) == png]
+            for method in ("R", "paper"):
+                pixels = sum(r.haze.get(method, 0) for r in mine)
+                cells.append(f"{pixels:7d} {sum(1 for r in mine if r.haze.get(method)):2d}/{len(mine):<2d}")
+        lines.append(f"{name:26s} {cells[0]:>14s} {cells[1]:>14s} {cells[2]:>14s} {cells[3]:>14s}")
+    return lines
+
+
 def _issue19_lines(results, summary):
     lines = ["", "== targets of issue 19 (asserted on the held-out half once met)"]
-    mixed = summary["mixed"]
-    text, photo = (mixed[region] for region in REGIONS)
-    if text[1] or photo[1]:
-        lines.append(f"mixed content, text/graphics regions' edge band, PNG originals ({text[1]} cases): "
-                     f"R {_reduction(text[0].get('R', np.nan)).strip()} ({_means(text[0], ('R',))}); target "
-                     f"{MIN_TEXT_REDUCTION}: {_verdict(text[0].get('R', -np.inf) >= MIN_TEXT_REDUCTION)}; "
-                     f"{len(text[2])} cases worse than F")
-        lines.append(f"mixed content, photo regions' edge band ({photo[1]} cases): R "
-                     f"{_reduction(photo[0].get('R', np.nan)).strip()} ({_means(photo[0], ('R',))}); target: at "
-                     f"least the calibrated strength of today's plan, no region worse than F: {len(photo[2])} cases "
-                     f"worse" + (f" ({', '.join(photo[2][:4])})" if photo[2] else ""))
-        overall, cases = mixed["overall"]
-        lines.append(f"mixed content, whole edge band ({cases} cases): R {_reduction(overall.get('R', np.nan)).strip()} "
-                     f"({_means(overall, ('R',))}); target {MIN_MIXED_REDUCTION}: "
-                     f"{_verdict(overall.get('R', -np.inf) >= MIN_MIXED_REDUCTION)}")
+    for key, which in (("mixed", "every filter"), ("mixed_pointwise", "point-wise filters")):
+        lines += _mixed_target_lines(summary[key], which)
     if summary["neighbourhood_cases"]:
         near = summary["neighbourhood"]
         loss, where = summary["neighbourhood_worst_db"]
@@ -191,6 +214,7 @@ def format_realtools(results, missing_tools=(), missing_peers=(), *, suite_name=
     lines += _group_lines(results, lambda r: r.scene, "family", methods)
     lines += _group_lines(results, lambda r: r.source, "source", methods, png_only=False)
     lines += _mixed_lines(results)
+    lines += _haze_lines(results)
     summary = summarize_realtools(results)
     lines += _target_lines(results, summary)
     lines += _issue19_lines(results, summary)
