@@ -125,8 +125,8 @@ def test_new_tools_run_and_their_groups_are_right(name):
 
 
 def test_opencv_filters_give_what_opencv_gives():
-    import cv2
     tool = require_tool("opencv")
+    import cv2
     image = _photo_tile()
     pixels = np.rint(image * 255).astype(np.uint8)
     threshold = tool.run(realtools.TOOL_FILTERS["cv-threshold"].command(), [image])[0]

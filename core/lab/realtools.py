@@ -300,13 +300,14 @@ _ALL_FAMILIES = tuple(FAMILIES)
 _ALL_FILTERS = tuple(TOOL_FILTERS)
 
 #: Every family in both spaces (photos and mixed content linear), every tool filter, O 96
-#: px wide: about 1000 PNG cases and as many JPEG ones.
+#: px wide: about 740 PNG cases and as many JPEG ones.
 REAL_FULL = RealToolsSuite("realtools", _ALL_FAMILIES, _ALL_FILTERS, 96,
                            {name: ("linear", "srgb") for name, f in FAMILIES.items() if f.kind not in _CAMERA_KINDS})
 #: Two drawings, two photos and one mixed scene per half, one space per drawing, O 64 px
 #: wide, JPEG at 85 and 95: the size for CI and for quick checks while tuning. Of the
-#: filters added with OpenCV and Pillow it runs one neighbourhood filter per half and one
-#: curve or threshold (a second minute on 2 cores is what the rest would cost).
+#: filters added with OpenCV and Pillow it runs one neighbourhood filter per half, and a
+#: non-monotonic curve (tune) or the scanning threshold (held out): each filter adds ten
+#: cases to a half, and the other eleven would nearly double its time.
 _QUICK_LEAVES_OUT = {"cv-smoothing", "cv-gamma", "cv-threshold", "pil-posterize", "pil-autocontrast",
                      "cv-detail-enhance", "cv-equalize", "cv-turbo", "pil-equalize", "pil-unsharp", "pil-gradient-map"}
 REAL_QUICK = RealToolsSuite("realtools-quick", ("maps", "starburst", "text", "coffee", "poster", "hatching", "pies",
