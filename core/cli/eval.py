@@ -1,8 +1,9 @@
 """``aarecovery eval``: quality against supersampled ground truth, beside the peer tools.
 
 Two suites: ``builtin`` (the project's filters on its own scenes) and ``realtools`` (GEGL,
-G'MIC and ImageMagick on drawings and photos, with PNG and JPEG originals), whose cases are
-split into a tuning half and a held-out half (``--half``).
+G'MIC, ImageMagick, OpenCV and Pillow on drawings, comics, photos, graphics over photos and
+scans of text, with PNG and JPEG originals), whose cases are split into a tuning half and a
+held-out half (``--half``).
 """
 
 import sys
@@ -20,10 +21,12 @@ def register(subparsers):
         "eval", help="measure recovery against supersampled ground truth, beside GIMP and G'MIC",
         description="Run every filter on every scene, recover, and print PSNR/SSIM tables of F, R (the safe "
                     "default), the paper's method and the installed peer tools against a supersampled reference. "
-                    "--suite realtools runs GEGL, G'MIC and ImageMagick instead, on one half of a fixed split.")
+                    "--suite realtools runs GEGL, G'MIC, ImageMagick, OpenCV and Pillow instead, on one half of a "
+                    "fixed split.")
     parser.add_argument("--suite", choices=("builtin", "realtools"), default="builtin",
-                        help="builtin: the project's filters on its scenes (default); realtools: GEGL, G'MIC and "
-                             "ImageMagick on drawings and photos, PNG and JPEG originals")
+                        help="builtin: the project's filters on its scenes (default); realtools: GEGL, G'MIC, "
+                             "ImageMagick, OpenCV and Pillow on drawings, photos, mixed content and scans, PNG and "
+                             "JPEG originals")
     parser.add_argument("--half", help="realtools only: tune (default), heldout or all; choose thresholds on tune, "
                                        "report heldout")
     parser.add_argument("--quick", action="store_true", help="the small suite (under a minute on 2 cores)")

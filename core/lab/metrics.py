@@ -9,7 +9,8 @@ import numpy as np
 from ..filters.spatial import gaussian_filter
 from ..spec.sobel import image_gradients
 
-__all__ = ["mse", "psnr", "ssim", "ssim_map", "edge_band", "error_reduction", "outside_local_range"]
+__all__ = ["mse", "psnr", "ssim", "ssim_map", "edge_band", "error_reduction", "outside_local_range", "haze_pixels",
+           "HAZE_TOLERANCE"]
 
 # An edge-band pixel is one where the reference and F differ by more than this (they
 # disagree there, so that is where a repair is needed or can harm) ...
@@ -18,6 +19,10 @@ _BAND_DIFFERENCE = 1.0 / 255
 # channel): an edge the repair will act on.
 _BAND_GRADIENT = 0.02
 _PSNR_CAP = 100.0
+#: How much darker than F a background pixel may come out before it counts as haze: two
+#: 8-bit steps of luma, above the rounding of any repair but far below a visible blotch.
+HAZE_TOLERANCE = 2.0 / 255
+_LUMA = np.array([0.2126, 0.7152, 0.0722], np.float32)  # Rec. 709, on encoded values
 
 
 def mse(a, b, mask=None):
@@ -123,3 +128,23 @@ def outside_local_range(image, filtered, slack=1.0 / 255):
     windows = [padded[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
     low, high = np.minimum.reduce(windows), np.maximum.reduce(windows)
     return ((image < low - slack) | (image > high + slack)).any(axis=-1)
+
+
+def haze_pixels(image, filtered, background, tolerance=HAZE_TOLERANCE):
+    """Background pixels that `image` makes darker than F: the haze a repair paints on paper.
+
+    Parameters
+    ----------
+    image, filtered : ndarray of float32, shape (H, W, 3)
+    background : ndarray of bool, shape (H, W)
+        Where the scene is paper (no ink in or next to the pixel).
+    tolerance : float
+        Luma (Rec. 709, encoded values) by which `image` must be darker than F to count.
+
+    Returns
+    -------
+    int
+        0 for F itself.
+    """
+    darker = (filtered - image) @ _LUMA > tolerance
+    return int((darker & background).sum())

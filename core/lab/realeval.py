@@ -8,7 +8,9 @@ case is measured on its PNG twin's edge band, so that both measure the same pixe
 
 Beside the quality it records what a user sees: the share of pixels R changed, the largest
 change, the pixels where R leaves the colour range of F's 3 x 3 neighbourhood (invented
-colour), and the safe default's reason. :func:`summarize_realtools` gives the issue's
+colour), and the safe default's reason. A mixed-content case is also measured on each of
+its regions' share of the edge band (text/graphics, photo), and a scan counts the haze each
+method paints on its paper background. :func:`summarize_realtools` gives the issues'
 target figures.
 """
 
@@ -20,6 +22,7 @@ from .evaluate import _NO_ERROR_PSNR_DB, MAX_LOSS_DB, CaseResult, _measure, _Pro
 
 __all__ = ["RealCaseResult", "run_realtools", "summarize_realtools", "METHODS", "MIN_HARD_REDUCTION",
            "MIN_JPEG_GAIN_KEPT", "MIN_PHOTO_POINTWISE_REDUCTION", "JPEG_TARGET_QUALITY", "MAX_LOSS_DB",
+           "MIN_TEXT_REDUCTION", "MIN_MIXED_REDUCTION", "MIN_NEIGHBOURHOOD_REDUCTION", "REGIONS",
            "mean_reductions"]
 
 #: Targets of issue 10, to be asserted on the held-out half once the safe default meets them.
@@ -27,11 +30,22 @@ MIN_HARD_REDUCTION = 0.75
 MIN_JPEG_GAIN_KEPT = 0.8
 JPEG_TARGET_QUALITY = 85
 MIN_PHOTO_POINTWISE_REDUCTION = 0.3
+#: Targets of issue 19 (held-out half, default settings): the text and graphics of mixed
+#: content repaired as a drawing is, the whole image at least this, and neighbourhood filters
+#: on hard-edged content.
+MIN_TEXT_REDUCTION = 0.9
+MIN_MIXED_REDUCTION = 0.6
+MIN_NEIGHBOURHOOD_REDUCTION = 0.6
+#: The regions of a mixed-content case, as :func:`aarecovery.lab.overlays.overlay_regions` names them.
+REGIONS = ("text/graphics", "photo")
 #: Columns, in order: F, the safe default, the paper's method and the peers.
 METHODS = ("F", "R", "paper", "gimp", "gmic", "jbf")
 _PEERS = ("gimp", "gmic", "jbf")
 # R "changed" a pixel when some channel moved by more than half an 8-bit step.
 _CHANGED = 0.5 / 255
+# A region has an error to reduce where F's MSE on it is over that of half an 8-bit step,
+# as for a whole case (CaseResult.has_error).
+_NO_ERROR_MSE = 10 ** (-_NO_ERROR_PSNR_DB / 10)
 
 
 @dataclass
@@ -50,6 +64,15 @@ class RealCaseResult(CaseResult):
         Largest ``|R - F|`` over pixels and channels.
     outside : dict of str to int
         Per method (and ``"reference"``): pixels outside F's local colour range.
+    region_error : dict of str to float
+        Mixed content: F's MSE on each region's part of the edge band.
+    region_reduction : dict of str to dict of str to float
+        Mixed content: per region, per method, the edge-band error reduction there.
+    haze : dict of str to int
+        Scans: per method, paper pixels it makes darker than F
+        (:func:`~aarecovery.lab.metrics.haze_pixels`).
+    paper_pixels : int
+        Scans: the size of the paper background.
     """
 
     tool: str = ""
@@ -59,6 +82,10 @@ class RealCaseResult(CaseResult):
     changed: float = 0.0
     max_change: float = 0.0
     outside: dict = field(default_factory=dict)
+    region_error: dict = field(default_factory=dict)
+    region_reduction: dict = field(default_factory=dict)
+    haze: dict = field(default_factory=dict)
+    paper_pixels: int = 0
 
     @property
     def source(self):
@@ -119,7 +146,7 @@ def run_realtools(suite, half="tune", *, backend="numpy", peers=True, jpeg=True,
     missing_peers : list of Peer
     """
     from ..engine import Engine
-    from .metrics import edge_band, error_reduction, outside_local_range, psnr, ssim_map
+    from .metrics import edge_band, error_reduction, haze_pixels, mse, outside_local_range, psnr, ssim_map
     from .peers import available_peers, joint_bilateral
     from .realtools import FAMILIES, TOOL_FILTERS, build_cases
     from .tools import available_tools
@@ -156,6 +183,14 @@ def run_realtools(suite, half="tune", *, backend="numpy", peers=True, jpeg=True,
             for method, image in outputs.items():
                 measure(result, method, image, ref, band, f)
             result.outside["reference"] = int(outside_local_range(ref, f).sum())
+            for region, mask in (case.regions or {}).items():
+                inside = band & mask
+                result.region_error[region] = mse(f, ref, inside)
+                result.region_reduction[region] = {m: error_reduction(image, f, ref, inside)
+                                                   for m, image in outputs.items() if m != "F"}
+            if case.paper is not None:
+                result.haze = {m: haze_pixels(image, f, case.paper) for m, image in outputs.items()}
+                result.paper_pixels = int(case.paper.sum())
             change = np.abs(recovered - f).max(axis=-1)
             result.changed = float((change > _CHANGED).mean())
             result.max_change = float(change.max())
@@ -211,9 +246,14 @@ def summarize_realtools(results):
         pairs where F has an error and the method gains on the PNG case;
         ``photo_pointwise``: mean reductions on photos with PNG originals under point-wise
         filters (threshold, levels, curves, posterize);
-        ``outside``: per method, (pixels outside F's local colour range, cases with any).
+        ``outside``: per method, (pixels outside F's local colour range, cases with any);
+        ``neighbourhood``: mean reductions on drawings with PNG originals under filters that
+        read a neighbourhood, ``neighbourhood_cases`` and ``neighbourhood_worst_db`` (R's
+        worst loss to F there, and the case);
+        ``mixed``: see :func:`summarize_mixed`, and ``mixed_pointwise`` the same under
+        point-wise filters; ``haze``: see :func:`summarize_haze`.
     """
-    from .realtools import POINTWISE_GROUPS
+    from .realtools import NEIGHBOURHOOD_GROUPS, POINTWISE_GROUPS
     summary = {}
     losses = [(r.psnr_band["F"] - r.psnr_band["R"], r.name) for r in results]
     summary["worst_loss_db"] = max(losses) if losses else (0.0, "")
@@ -250,4 +290,63 @@ def summarize_realtools(results):
     summary["outside"] = {m: (sum(r.outside.get(m, 0) for r in results), sum(1 for r in results if r.outside.get(m)))
                           for m in ["R", "paper", "jbf", "gimp", "gmic", "reference"]
                           if any(m in r.outside for r in results)}
+    neighbourhood = [r for r in hard if r.group in NEIGHBOURHOOD_GROUPS]
+    summary["neighbourhood"], summary["neighbourhood_cases"] = mean_reductions(neighbourhood)
+    summary["neighbourhood_worst_db"] = max(((r.psnr_band["F"] - r.psnr_band["R"], r.name) for r in neighbourhood),
+                                            default=(0.0, ""))
+    summary["mixed"] = summarize_mixed([r for r in png if r.kind == "mixed"])
+    # Issue 19 saw the split of one strength between text and photo under point-wise filters.
+    summary["mixed_pointwise"] = summarize_mixed([r for r in png if r.kind == "mixed" and r.group in POINTWISE_GROUPS])
+    summary["haze"] = summarize_haze([r for r in results if r.kind == "scan"])
+    return summary
+
+
+def summarize_mixed(results):
+    """Mixed content per region: what a local plan must reach on each part of the image.
+
+    Parameters
+    ----------
+    results : list of RealCaseResult
+        Mixed-content cases (the summary passes those with PNG originals).
+
+    Returns
+    -------
+    dict
+        Per region of :data:`REGIONS`: ``(means, cases, worse)``, the mean reduction per
+        method over the cases where F has an error in that region, their number, and the
+        cases where R is worse than F there (reduction below 0); ``"overall"``: ``(means,
+        cases)`` over the whole edge band.
+    """
+    summary = {}
+    for region in REGIONS:
+        picked = [r for r in results if r.region_error.get(region, 0.0) > _NO_ERROR_MSE]
+        methods = [m for m in METHODS[1:] if picked and all(m in r.region_reduction[region] for r in picked)]
+        means = {m: _mean(r.region_reduction[region][m] for r in picked) for m in methods}
+        worse = [r.name for r in picked if r.region_reduction[region]["R"] < 0]
+        summary[region] = (means, len(picked), worse)
+    summary["overall"] = mean_reductions(results)
+    return summary
+
+
+def summarize_haze(results):
+    """Haze on scans: paper pixels each method makes darker than F, per source.
+
+    Returns
+    -------
+    dict of str to dict
+        Per source (``"png"``, ``"jpeg75"``...) and ``"jpeg"`` (every quality): per method,
+        ``(pixels, cases with any, cases)``; ``"paper_pixels"``: the paper background of those cases.
+    """
+    groups = {}
+    for r in sorted(results, key=lambda r: (r.quality is not None, r.quality or 0)):
+        groups.setdefault(r.source, []).append(r)
+    jpeg = [r for r in results if r.quality is not None]
+    if jpeg:
+        groups["jpeg"] = jpeg
+    summary = {}
+    for label, chosen in groups.items():
+        methods = [m for m in METHODS if all(m in r.haze for r in chosen)]
+        summary[label] = {m: (sum(r.haze[m] for r in chosen), sum(1 for r in chosen if r.haze[m]), len(chosen))
+                          for m in methods}
+        summary[label]["paper_pixels"] = sum(r.paper_pixels for r in chosen)
     return summary

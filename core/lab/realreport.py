@@ -4,8 +4,10 @@ import os
 
 import numpy as np
 
+from .metrics import HAZE_TOLERANCE
 from .realeval import (JPEG_TARGET_QUALITY, MAX_LOSS_DB, METHODS, MIN_HARD_REDUCTION, MIN_JPEG_GAIN_KEPT,
-                       MIN_PHOTO_POINTWISE_REDUCTION, mean_reductions, summarize_realtools)
+                       MIN_MIXED_REDUCTION, MIN_NEIGHBOURHOOD_REDUCTION, MIN_PHOTO_POINTWISE_REDUCTION,
+                       MIN_TEXT_REDUCTION, REGIONS, mean_reductions, summarize_mixed, summarize_realtools)
 from .report import TABLES_FILE, generated_block, markdown_table
 
 __all__ = ["format_realtools", "realtools_markdown_tables", "write_realtools_report", "WORST_SHOWN"]
@@ -175,6 +177,90 @@ def realtools_markdown_tables(results, missing_tools=(), missing_peers=(), *, su
     return generated_block(command, "\n".join(lines))
 
 
+def _means(values, skip=()):
+    return ", ".join(f"{m} {_reduction(v).strip()}" for m, v in values.items() if m not in skip)
+
+
+def _mixed_target_lines(mixed, which):
+    text, photo = (mixed[region] for region in REGIONS)
+    if not (text[1] or photo[1]):
+        return []
+    overall, cases = mixed["overall"]
+    return [f"mixed content under {which}, text/graphics regions' edge band, PNG originals ({text[1]} cases): "
+            f"R {_reduction(text[0].get('R', np.nan)).strip()} ({_means(text[0], ('R',))}); target "
+            f"{MIN_TEXT_REDUCTION}: {_verdict(text[0].get('R', -np.inf) >= MIN_TEXT_REDUCTION)}; "
+            f"{len(text[2])} cases worse than F",
+            f"mixed content under {which}, photo regions' edge band ({photo[1]} cases): R "
+            f"{_reduction(photo[0].get('R', np.nan)).strip()} ({_means(photo[0], ('R',))}); target: at least "
+            f"the calibrated strength of today's plan, no region worse than F: {len(photo[2])} cases worse"
+            + (f" ({', '.join(photo[2][:4])})" if photo[2] else ""),
+            f"mixed content under {which}, whole edge band ({cases} cases): R "
+            f"{_reduction(overall.get('R', np.nan)).strip()} ({_means(overall, ('R',))}); target "
+            f"{MIN_MIXED_REDUCTION}: {_verdict(overall.get('R', -np.inf) >= MIN_MIXED_REDUCTION)}"]
+
+
+def _haze_lines(results):
+    scans = [r for r in results if r.kind == "scan"]
+    if not scans:
+        return []
+    lines = ["", f"== scans: haze per filter, paper pixels made darker than F by more than {HAZE_TOLERANCE * 255:g}/255 "
+                 "in luma (cases with any / cases)",
+             f"{'filter':26s} {'R png':>14s} {'paper png':>14s} {'R jpeg':>14s} {'paper jpeg':>14s}"]
+    for name in dict.fromkeys(r.filter_name for r in scans):
+        cells = []
+        for png in (True, False):
+            mine = [r for r in scans if r.filter_name == name and (r.quality is None) == png]
+            for method in ("R", "paper"):
+                pixels = sum(r.haze.get(method, 0) for r in mine)
+                cells.append(f"{pixels:7d} {sum(1 for r in mine if r.haze.get(method)):2d}/{len(mine):<2d}")
+        lines.append(f"{name:26s} {cells[0]:>14s} {cells[1]:>14s} {cells[2]:>14s} {cells[3]:>14s}")
+    return lines
+
+
+def _issue19_lines(results, summary):
+    lines = ["", "== targets of issue 19 (asserted on the held-out half once met)"]
+    for key, which in (("mixed", "every filter"), ("mixed_pointwise", "point-wise filters")):
+        lines += _mixed_target_lines(summary[key], which)
+    if summary["neighbourhood_cases"]:
+        near = summary["neighbourhood"]
+        loss, where = summary["neighbourhood_worst_db"]
+        lines.append(f"neighbourhood filters (unsharp, bilateral, abstraction, detail) on hard-edged drawings, PNG "
+                     f"originals ({summary['neighbourhood_cases']} cases): R {_reduction(near.get('R', np.nan)).strip()}"
+                     f" ({_means(near, ('R',))}); target {MIN_NEIGHBOURHOOD_REDUCTION}: "
+                     f"{_verdict(near.get('R', -np.inf) >= MIN_NEIGHBOURHOOD_REDUCTION)}; worst loss to F "
+                     f"{loss:+.2f} dB ({where})")
+    haze = summary["haze"]
+    if haze:
+        parts = []
+        for label, values in haze.items():
+            counts = ", ".join(f"{m} {values[m][0]} px in {values[m][1]}" for m in ("R", "paper", "jbf") if m in values)
+            parts.append(f"{label} ({values['R'][2]} cases, {values['paper_pixels']} paper px): {counts}")
+        lines.append(f"scans: haze, paper pixels made darker than F by more than {HAZE_TOLERANCE * 255:g}/255 in luma; "
+                     f"target 0 (F has none by definition): " + "; ".join(parts))
+    return lines
+
+
+def _mixed_lines(results):
+    mixed = [r for r in results if r.kind == "mixed" and r.quality is None]
+    if not mixed:
+        return []
+    lines = ["", "== mixed content per family: mean edge-band error reduction per region, PNG cases where F has an "
+                 "error there (n)",
+             f"{'family':14s} " + " ".join(f"{region + ' R':>17s} {'paper':>7s} {'n':>3s}" for region in REGIONS)
+             + f" {'overall R':>10s} {'paper':>7s}"]
+    for family in dict.fromkeys(r.scene for r in mixed):
+        summary = summarize_mixed([r for r in mixed if r.scene == family])
+        cells = []
+        for region in REGIONS:
+            means, count, _ = summary[region]
+            cells.append(f"{_reduction(means.get('R', np.nan)):>17s} {_reduction(means.get('paper', np.nan))} "
+                         f"{count:3d}")
+        overall = summary["overall"][0]
+        lines.append(f"{family:14s} " + " ".join(cells) + f" {_reduction(overall.get('R', np.nan)):>10s} "
+                     f"{_reduction(overall.get('paper', np.nan))}")
+    return lines
+
+
 def format_realtools(results, missing_tools=(), missing_peers=(), *, suite_name="realtools", half="tune"):
     """Plain-text report of a real-tools run: what ``aarecovery eval --suite realtools`` prints."""
     methods = _present(results)
@@ -185,8 +271,7 @@ def format_realtools(results, missing_tools=(), missing_peers=(), *, suite_name=
     if half != "tune":
         lines.append(_HELD_OUT_WARNING)
     for tool in missing_tools:
-        lines.append(f"!! {tool.label} is NOT installed (none of {', '.join(tool.commands)} found; Debian package "
-                     f"'{tool.package}'): its cases are missing")
+        lines.append(f"!! {tool.label} is NOT installed ({tool.install_hint()}): its cases are missing")
     for peer in missing_peers:
         lines.append(f"!! {peer.label} is NOT installed (`{peer.command}` not found; Debian package "
                      f"'{peer.package}'): its column is missing")
@@ -198,8 +283,11 @@ def format_realtools(results, missing_tools=(), missing_peers=(), *, suite_name=
     lines += _group_lines(results, lambda r: r.group, "group", methods)
     lines += _group_lines(results, lambda r: r.scene, "family", methods)
     lines += _group_lines(results, lambda r: r.source, "source", methods, png_only=False)
+    lines += _mixed_lines(results)
+    lines += _haze_lines(results)
     summary = summarize_realtools(results)
     lines += _target_lines(results, summary)
+    lines += _issue19_lines(results, summary)
     worst = sorted(results, key=lambda r: r.psnr_band["R"] - r.psnr_band["F"])[:WORST_SHOWN]
     lines += ["", f"== the {len(worst)} worst cases of the safe default (edge-band PSNR of R minus F)",
               f"{'case':44s} {'F':>6s} {'R':>6s} {'R-F dB':>7s} {'red R':>7s} {'chg%':>6s} {'max':>6s} "

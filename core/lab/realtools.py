@@ -1,4 +1,4 @@
-"""The real-tools suite: scenes filtered by GEGL, G'MIC and ImageMagick, and its fixed split.
+"""The real-tools suite: scenes filtered by GEGL, G'MIC, ImageMagick, OpenCV and Pillow, and its fixed split.
 
 A case is a scene family, an antialiasing space, a tool filter and a source format:
 
@@ -13,14 +13,23 @@ A case is a scene family, an antialiasing space, a tool filter and a source form
   computes it on the scene as it would on any image. A JPEG case has its PNG case's
   reference.
 
-Drawings (:mod:`aarecovery.lab.drawings`) are rendered at ``k = 8`` in both antialiasing
-spaces; photos (``core/data/photo_*``, see ``core/data/LICENSE.md``) are their own scene at
-full resolution, box-downsampled by ``k = 4`` in linear light (they are camera images).
+Drawings (:mod:`aarecovery.lab.drawings`, comics from :mod:`aarecovery.lab.comics`) and
+scans of text (:mod:`aarecovery.lab.overlays`) are rendered at ``k = 8`` in both
+antialiasing spaces; photos (``core/data/photo_*``, see ``core/data/LICENSE.md``) are their
+own scene at full resolution, box-downsampled by ``k = 4`` in linear light (they are camera
+images); mixed content is a photo's scene with text and graphics drawn over it, at ``k = 4``.
+A mixed case carries its regions (text/graphics and photo, from the overlay drawn on the
+scene), a scan its paper background (no ink within a pixel), so that the evaluation can
+report each region and the haze a repair paints on the paper.
 
 **The split.** Every family and every tool filter belongs to one half, ``tune`` or
 ``heldout``, and a case exists only where both agree, so that the held-out half has scene
 families *and* tool operations that the tuning half never shows (and every tool has
-operations in both halves). Choose thresholds on ``tune``; report ``heldout``.
+operations in both halves). Choose thresholds on ``tune``; report ``heldout``. Families and
+filters added later are assigned the same way, in pairs, one of each pair to each half:
+mixed content ``poster``, ``screenshot`` (tune) against ``banner``, ``mapphoto`` (held out);
+scans ``memo`` (tune) against ``letter``; comics ``manga`` (tune) against ``comicstrip``; and
+for OpenCV and Pillow, operations of each kind on both sides (see :data:`TOOL_FILTERS`).
 """
 
 import zlib
@@ -31,17 +40,28 @@ import numpy as np
 
 from ..errors import InputError
 from ..plan.resample import box_downsample
+from .comics import COMICS
 from .drawings import DRAWINGS
+from .overlays import MIXED, SCANS, overlay_regions, paper_background
 
-__all__ = ["Family", "ToolFilter", "FAMILIES", "TOOL_FILTERS", "HALVES", "POINTWISE_GROUPS", "RealCase",
-           "RealToolsSuite", "REAL_QUICK", "REAL_FULL", "build_cases", "render_family"]
+__all__ = ["Family", "ToolFilter", "FAMILIES", "TOOL_FILTERS", "HALVES", "POINTWISE_GROUPS", "NEIGHBOURHOOD_GROUPS",
+           "RealCase", "RealToolsSuite", "REAL_QUICK", "REAL_FULL", "build_cases", "render_family", "render_scene"]
 
 #: The two halves of the split, and "all" (both).
 HALVES = ("tune", "heldout", "all")
 #: Filter groups whose tools act on each pixel alone, as the issue's photo target counts them.
-POINTWISE_GROUPS = ("threshold", "levels", "curves", "posterize")
+#: A gradient map (a colour map of the grey value) is one of them: each output pixel is a
+#: function of its own input pixel alone.
+POINTWISE_GROUPS = ("threshold", "levels", "curves", "posterize", "gradient-map")
+#: Filter groups whose output pixel reads its neighbours: the issue's neighbourhood target
+#: counts them on hard-edged content.
+NEIGHBOURHOOD_GROUPS = ("unsharp", "bilateral", "abstraction", "detail")
+#: Scans are JPEG files at these qualities (the scanning workflow's range).
+_SCAN_QUALITIES = (75, 80, 85, 90, 95)
 _DRAWING_K = 8
 _PHOTO_K = 4
+#: Kinds whose scenes are camera images (antialiased in linear light only).
+_CAMERA_KINDS = ("photo", "mixed")
 
 
 @dataclass(frozen=True)
@@ -51,12 +71,15 @@ class Family:
     Attributes
     ----------
     name : str
-    kind : {"drawing", "photo"}
+    kind : {"drawing", "photo", "mixed", "scan"}
+        Drawings include the comics; mixed content is a photo with graphics over it.
     half : {"tune", "heldout"}
     k : int
         Supersampling factor: the scene is ``k`` times O's size.
     source : str
-        For photos, the file in ``core/data``.
+        For photos and mixed content, the photo's file in ``core/data``.
+    jpeg_qualities : tuple of int
+        The family's own JPEG qualities (scans), instead of the suite's.
     """
 
     name: str
@@ -64,6 +87,7 @@ class Family:
     half: str
     k: int
     source: str = ""
+    jpeg_qualities: tuple = ()
 
 
 FAMILIES = {f.name: f for f in (
@@ -85,6 +109,18 @@ FAMILIES = {f.name: f for f in (
     Family("astronaut", "photo", "heldout", _PHOTO_K, "photo_astronaut.jpg"),
     Family("rocket", "photo", "heldout", _PHOTO_K, "photo_rocket.jpg"),
     Family("chelsea", "photo", "heldout", _PHOTO_K, "photo_chelsea.jpg"),
+    # Comics with screentone: black dot tone and hatching; held out: colour Ben-Day dots.
+    Family("manga", "drawing", "tune", _DRAWING_K),
+    Family("comicstrip", "drawing", "heldout", _DRAWING_K),
+    # Mixed content over the half's own photos: a café poster, a viewer window's chrome;
+    # held out: a web banner, map lines and labels over a satellite-like view.
+    Family("poster", "mixed", "tune", _PHOTO_K, "photo_coffee.jpg"),
+    Family("screenshot", "mixed", "tune", _PHOTO_K, "photo_camera.png"),
+    Family("banner", "mixed", "heldout", _PHOTO_K, "photo_chelsea.jpg"),
+    Family("mapphoto", "mixed", "heldout", _PHOTO_K, "photo_rocket.jpg"),
+    # Scans of text: serif on cream; held out: sans on grained grey-blue paper.
+    Family("memo", "scan", "tune", _DRAWING_K, jpeg_qualities=_SCAN_QUALITIES),
+    Family("letter", "scan", "heldout", _DRAWING_K, jpeg_qualities=_SCAN_QUALITIES),
 )}
 
 
@@ -101,8 +137,9 @@ class ToolFilter:
     arguments : tuple of str
         The command line after the input; ``{name}`` fields are lengths from `lengths`.
     group : str
-        What kind of filter it is: threshold, levels, curves, posterize, equalize, hue,
-        grey, unsharp or bilateral.
+        What kind of filter it is: point-wise (threshold, levels, curves, posterize,
+        gradient-map, equalize, hue, grey) or reading a neighbourhood (unsharp, bilateral,
+        abstraction: edge-preserving smoothing, detail: detail enhancement).
     half : {"tune", "heldout"}
     lengths : dict of str to float
         Lengths in pixels at O's resolution, multiplied by ``k`` on the scene.
@@ -170,6 +207,33 @@ TOOL_FILTERS = {f.name: f for f in (
     _tf("im-gray", "imagemagick", ["-colorspace", "Gray"], "grey", "heldout"),
     _tf("im-modulate", "imagemagick", ["-modulate", "100,100,150"], "hue", "heldout"),
     _tf("im-equalize", "imagemagick", ["-equalize"], "equalize", "heldout", whole_image=True),
+    # The scanning workflow of issue 19: a page thresholded a little above the middle.
+    _tf("im-threshold-55", "imagemagick", ["-threshold", "55%"], "threshold", "heldout"),
+    # OpenCV and Pillow, in-process (aarecovery.lab.pytools). Each half gets a smoothing
+    # filter, an abstraction, a curve and a threshold or equalization of its own:
+    # tune: bilateral, normalized-convolution smoothing, LUT gamma, threshold; Pillow's posterize, solarize (a
+    # non-monotonic curve) and autocontrast.
+    _tf("cv-bilateral", "opencv", ["bilateral", "sigma_space={sigma}", "sigma_colour=40"], "bilateral", "tune",
+        {"sigma": 1.5}),
+    _tf("cv-smoothing", "opencv", ["edge-preserving", "flags=2", "sigma_s={sigma}", "sigma_r=0.3"], "abstraction",
+        "tune", {"sigma": 6.0}),
+    _tf("cv-gamma", "opencv", ["gamma", "gamma=2.2"], "curves", "tune"),
+    _tf("cv-threshold", "opencv", ["threshold", "value=127"], "threshold", "tune"),
+    _tf("pil-posterize", "pillow", ["posterize", "bits=2"], "posterize", "tune"),
+    _tf("pil-solarize", "pillow", ["solarize", "threshold=160"], "curves", "tune"),
+    _tf("pil-autocontrast", "pillow", ["autocontrast", "cutoff=2"], "levels", "tune", whole_image=True),
+    # Held out: edge-preserving smoothing, detail enhancement, equalization and a TURBO colour
+    # map of the grey value; Pillow's equalize, unsharp mask and a gradient map.
+    _tf("cv-edge-preserving", "opencv", ["edge-preserving", "flags=1", "sigma_s={sigma}", "sigma_r=0.4"], "abstraction",
+        "heldout", {"sigma": 8.0}),
+    _tf("cv-detail-enhance", "opencv", ["detail-enhance", "sigma_s={sigma}", "sigma_r=0.15"], "detail", "heldout",
+        {"sigma": 4.0}),
+    _tf("cv-equalize", "opencv", ["equalize"], "equalize", "heldout", whole_image=True),
+    _tf("cv-turbo", "opencv", ["turbo"], "gradient-map", "heldout"),
+    _tf("pil-equalize", "pillow", ["equalize"], "equalize", "heldout", whole_image=True),
+    _tf("pil-unsharp", "pillow", ["unsharp", "radius={radius}", "percent=150", "threshold=3"], "unsharp", "heldout",
+        {"radius": 1.5}),
+    _tf("pil-gradient-map", "pillow", ["gradient-map"], "gradient-map", "heldout"),
 )}
 
 
@@ -217,7 +281,7 @@ class RealToolsSuite:
             family = FAMILIES[name]
             if half != "all" and family.half != half:
                 continue
-            spaces = ("linear",) if family.kind == "photo" else self.spaces.get(name, ("linear", "srgb"))
+            spaces = ("linear",) if family.kind in _CAMERA_KINDS else self.spaces.get(name, ("linear", "srgb"))
             for space in spaces:
                 for filter_name in self.filters:
                     if TOOL_FILTERS[filter_name].half == family.half:
@@ -225,22 +289,31 @@ class RealToolsSuite:
         return chosen
 
     def jpeg_quality(self, family, space, filter_name):
-        """The JPEG quality of a case's JPEG twin: fixed by its name, spread over the qualities."""
+        """The JPEG quality of a case's JPEG twin: fixed by its name, spread over the qualities
+        (the family's own, for scans, else the suite's)."""
+        qualities = FAMILIES[family].jpeg_qualities or self.jpeg_qualities
         key = zlib.crc32(f"{family}/{space}/{filter_name}".encode())
-        return self.jpeg_qualities[key % len(self.jpeg_qualities)]
+        return qualities[key % len(qualities)]
 
 
 _ALL_FAMILIES = tuple(FAMILIES)
 _ALL_FILTERS = tuple(TOOL_FILTERS)
 
-#: Every family in both spaces (photos linear), every tool filter, O 96 px wide: about
-#: 460 PNG cases and as many JPEG ones.
+#: Every family in both spaces (photos and mixed content linear), every tool filter, O 96
+#: px wide: about 740 PNG cases and as many JPEG ones.
 REAL_FULL = RealToolsSuite("realtools", _ALL_FAMILIES, _ALL_FILTERS, 96,
-                           {name: ("linear", "srgb") for name, f in FAMILIES.items() if f.kind == "drawing"})
-#: Two drawings and two photos per half, one space per drawing, O 64 px wide, JPEG at 85 and
-#: 95: the size for CI and for quick checks while tuning.
-REAL_QUICK = RealToolsSuite("realtools-quick", ("maps", "starburst", "text", "coffee", "hatching", "pies",
-                                                "towers", "rocket"), _ALL_FILTERS, 64,
+                           {name: ("linear", "srgb") for name, f in FAMILIES.items() if f.kind not in _CAMERA_KINDS})
+#: Two drawings, two photos and one mixed scene per half, one space per drawing, O 64 px
+#: wide, JPEG at 85 and 95 (160 cases in the tuning half, 140 held out): the size for CI
+#: and for quick checks while tuning. Of the
+#: filters added with OpenCV and Pillow it runs one neighbourhood filter per half, and a
+#: non-monotonic curve (tune) or the scanning threshold (held out): each filter adds ten
+#: cases to a half, and the other eleven would nearly double its time.
+_QUICK_LEAVES_OUT = {"cv-smoothing", "cv-gamma", "cv-threshold", "pil-posterize", "pil-autocontrast",
+                     "cv-detail-enhance", "cv-equalize", "cv-turbo", "pil-equalize", "pil-unsharp", "pil-gradient-map"}
+REAL_QUICK = RealToolsSuite("realtools-quick", ("maps", "starburst", "text", "coffee", "poster", "hatching", "pies",
+                                                "towers", "rocket", "banner"),
+                            tuple(f for f in _ALL_FILTERS if f not in _QUICK_LEAVES_OUT), 64,
                             {"maps": ("srgb",), "starburst": ("linear",), "hatching": ("srgb",),
                              "pies": ("linear",)}, (85, 95))
 
@@ -248,12 +321,33 @@ REAL_QUICK = RealToolsSuite("realtools-quick", ("maps", "starburst", "text", "co
 def render_family(name, width):
     """A family's scene: float32 ``(H * k, W * k, 3)``, sRGB-encoded, on the 8-bit grid.
 
-    Drawings are square, `width` pixels at O's size; photos are their bundled crop, trimmed
-    to a multiple of ``k``.
+    Drawings and scans are square, `width` pixels at O's size; photos and mixed content are
+    their photo's bundled crop, trimmed to a multiple of ``k``.
+    """
+    return render_scene(name, width)[0]
+
+
+def render_scene(name, width):
+    """A family's scene and where its overlay (mixed content) or ink (scans) was drawn.
+
+    Returns
+    -------
+    scene : ndarray of float32, shape (H * k, W * k, 3)
+    mask : ndarray of bool, shape (H * k, W * k), or None
+        None for drawings and photos.
     """
     family = FAMILIES[name]
     if family.kind == "drawing":
-        return DRAWINGS[name](width, width, family.k)
+        return {**DRAWINGS, **COMICS}[name](width, width, family.k), None
+    if family.kind == "scan":
+        return SCANS[name](width, width, family.k)
+    photo = _photo(family)
+    if family.kind == "mixed":
+        return MIXED[name](photo, family.k)
+    return photo, None
+
+
+def _photo(family):
     from PIL import Image
     with resources.files("aarecovery").joinpath(f"data/{family.source}").open("rb") as handle:
         image = np.asarray(Image.open(handle).convert("RGB"), np.float32) / np.float32(255)
@@ -288,6 +382,10 @@ class RealCase:
     quality : int or None
         JPEG quality of O, None for PNG.
     original, filtered, reference : ndarray of float32, shape (H, W, 3)
+    regions : dict of str to ndarray of bool, shape (H, W), or None
+        Mixed content: ``"text/graphics"`` and ``"photo"``, a partition of the image.
+    paper : ndarray of bool, shape (H, W), or None
+        Scans: the paper background, no ink within a pixel.
     """
 
     family: str
@@ -297,6 +395,8 @@ class RealCase:
     original: np.ndarray = None
     filtered: np.ndarray = None
     reference: np.ndarray = None
+    regions: dict = None
+    paper: np.ndarray = None
 
 
 def build_cases(suite, half="tune", *, jpeg=True, tools=None, progress=None):
@@ -319,19 +419,27 @@ def build_cases(suite, half="tune", *, jpeg=True, tools=None, progress=None):
     """
     from .tools import TOOLS
     chosen = [c for c in suite.cases(half) if tools is None or TOOL_FILTERS[c[2]].tool in tools]
-    scenes = {name: render_family(name, suite.width) for name in dict.fromkeys(c[0] for c in chosen)}
+    rendered = {name: render_scene(name, suite.width) for name in dict.fromkeys(c[0] for c in chosen)}
+    scenes = {name: scene for name, (scene, _) in rendered.items()}
+    regions, papers = {}, {}
+    for name, (_, mask) in rendered.items():
+        if FAMILIES[name].kind == "mixed":
+            regions[name] = overlay_regions(mask, FAMILIES[name].k)
+        elif FAMILIES[name].kind == "scan":
+            papers[name] = paper_background(mask, FAMILIES[name].k)
     originals = {}
     for name, space, _ in chosen:
         if (name, space, None) not in originals:
             originals[name, space, None] = _quantised(box_downsample(scenes[name], FAMILIES[name].k, space))
     cases = []
     for name, space, filter_name in chosen:
-        cases.append(RealCase(name, space, filter_name, None, originals[name, space, None]))
+        marks = {"regions": regions.get(name), "paper": papers.get(name)}
+        cases.append(RealCase(name, space, filter_name, None, originals[name, space, None], **marks))
         if jpeg:
             quality = suite.jpeg_quality(name, space, filter_name)
             if (name, space, quality) not in originals:
                 originals[name, space, quality] = _jpeg_round_trip(originals[name, space, None], quality)
-            cases.append(RealCase(name, space, filter_name, quality, originals[name, space, quality]))
+            cases.append(RealCase(name, space, filter_name, quality, originals[name, space, quality], **marks))
     for filter_name in dict.fromkeys(c.filter_name for c in cases):
         spec = TOOL_FILTERS[filter_name]
         tool = TOOLS[spec.tool]

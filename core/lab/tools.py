@@ -1,4 +1,5 @@
-"""The real image tools, run as their command lines run them: GEGL, G'MIC and ImageMagick.
+"""The real image tools, run as their command lines run them: GEGL, G'MIC and ImageMagick;
+OpenCV and Pillow run in-process (:mod:`aarecovery.lab.pytools`).
 
 * **GEGL** (the ``gegl`` command, Debian package ``gegl``): GIMP 3's filters are GEGL
   operations (``gegl:threshold``, ``gegl:levels``, ``gegl:unsharp-mask``...);
@@ -26,6 +27,8 @@ import tempfile
 from dataclasses import dataclass
 
 import numpy as np
+
+from .pytools import OPENCV, PILLOW
 
 __all__ = ["Tool", "TOOLS", "available_tools", "run_command", "read_float_rgb", "write_png8"]
 
@@ -184,6 +187,10 @@ class Tool:
         """bool: the tool is installed."""
         return self.executable() is not None
 
+    def install_hint(self):
+        """What to install when it is missing."""
+        return f"none of {', '.join(self.commands)} found; Debian package '{self.package}'"
+
     def run(self, arguments, images, *, support=0.0, whole_image=False):
         """Apply the tool with `arguments` to each image of a batch.
 
@@ -206,8 +213,7 @@ class Tool:
         """
         executable = self.executable()
         if executable is None:
-            raise RuntimeError(f"{self.label} is not installed (none of {', '.join(self.commands)} found; "
-                               f"Debian package '{self.package}')")
+            raise RuntimeError(f"{self.label} is not installed ({self.install_hint()})")
         if not images:
             return []
         with tempfile.TemporaryDirectory(prefix=f"aarecovery-{self.name}-") as folder:
@@ -220,6 +226,8 @@ TOOLS = {t.name: t for t in (
     # `convert` is also the name of other programs (Windows' disk converter, placeholders
     # on some machines): only a command whose -version names ImageMagick counts.
     Tool("imagemagick", "ImageMagick", ("magick", "convert"), "imagemagick", _imagemagick_batch, "ImageMagick"),
+    OPENCV,
+    PILLOW,
 )}
 
 
