@@ -18,7 +18,7 @@ class GLUnavailable(InputError, RuntimeError):
 
     def __init__(self, reason):
         super().__init__(f"no OpenGL 3.3 context here ({reason}); use the NumPy backend (--backend numpy, "
-                         "backend='numpy': the same result, slower), or install an OpenGL 3.3 driver "
+                         "backend='numpy': the same result up to float rounding, slower), or install an OpenGL 3.3 driver "
                          "(Debian and Ubuntu: apt-get install libegl1 libgl1-mesa-dri)")
         self.reason = reason
 
