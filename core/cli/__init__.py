@@ -111,6 +111,17 @@ def _warnings_as_lines():
         yield
 
 
+def _memory_advice(args):
+    """What may help a command that ran out of memory: only the options it has, and the
+    backend only where it recovers (``filter`` without ``--recover`` does not)."""
+    advice = []
+    if getattr(args, "tile_size", False) is not False:
+        advice.append("a smaller --tile-size")
+    if getattr(args, "backend", "numpy") != "numpy" and getattr(args, "recover", True):
+        advice.append("--backend numpy")
+    return ", ".join(advice + ["closing other programs or a machine with more memory"])
+
+
 def main(argv=None):
     """Run the command line; return the exit status (0 on success, 128 + N after signal N)."""
     parser = build_parser()
@@ -132,8 +143,8 @@ def main(argv=None):
         return 1
     except MemoryError as error:
         # The core says how much it needed where it can (NotEnoughMemory); anything else is bare.
-        print(f"aarecovery: error: {str(error) or 'out of memory'}" + ("" if isinstance(error, NotEnoughMemory) else
-              "; try a smaller --tile-size, --backend numpy, or a machine with more memory"), file=sys.stderr)
+        advice = "" if isinstance(error, NotEnoughMemory) else f"; try {_memory_advice(args)}"
+        print(f"aarecovery: error: {str(error) or 'out of memory'}{advice}", file=sys.stderr)
         return 1
     except KeyboardInterrupt as interruption:
         number = getattr(interruption, "signum", signal.SIGINT)
