@@ -332,6 +332,14 @@ def test_a_filter_command_that_runs_too_long_is_stopped_and_reported(tmp_path, c
     assert not (tmp_path / "r" / "a.png").exists() and no_temporary_files(tmp_path) == []
 
 
+def test_a_filter_command_printing_a_10_mb_line_is_reported_in_a_short_line(tmp_path, capsys):
+    write_pairs(tmp_path, ["a.png"])
+    status, out, err = run_batch(capsys, tmp_path / "o", "-o", tmp_path / "r", "--backend", "numpy", "--filter-cmd",
+                                 "python3 -c 'import sys; sys.stderr.write(\"x\" * 10**7); sys.exit(3)' {in} {out}")
+    assert status == 1 and "exited with status 3" in err and "more characters" in err
+    assert len(err) < 1000, len(err)
+
+
 def test_max_image_memory_is_the_limit_of_each_image_read(tmp_path, capsys):
     """A file declaring more than the limit fails alone, with the option that raises it."""
     write_pairs(tmp_path, ["small.png"])
@@ -388,3 +396,12 @@ def test_ctrl_c_stops_a_running_filter_command_and_its_children(tmp_path):
     time.sleep(6.5 - (time.monotonic() - interrupted))
     assert not marker.exists(), "a child of the filter command went on running after Ctrl+C"
     assert no_temporary_files(tmp_path) == []
+
+
+def test_relative_paths_with_a_dask_scheduler_address_are_refused_saying_where_they_resolve(tmp_path, capsys,
+                                                                                          monkeypatch):
+    write_pairs(tmp_path, ["a.png"])
+    monkeypatch.chdir(tmp_path)
+    status, _, err = run_batch(capsys, "o", "f", "-o", tmp_path / "r", "--dask", "tcp://127.0.0.1:9")
+    assert status == 1 and err.count("\n") == 1, err
+    assert "'o' is a relative path" in err and "resolve paths on their side" in err and str(tmp_path / "o") in err

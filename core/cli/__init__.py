@@ -16,6 +16,7 @@ from .. import __version__
 from ..errors import AarecoveryWarning, InputError, NotEnoughMemory
 from ..extras import extra_for, missing_extra
 from ..gimp import cli as gimp_command
+from ..io import os_error_line
 from ..viewer import cli as view_command
 from . import batch as batch_command
 from . import bench as bench_command
@@ -138,8 +139,11 @@ def main(argv=None):
             raise
         print(f"aarecovery: error: {missing_extra(args.prog, extra, error)}", file=sys.stderr)
         return 1
-    except (InputError, OSError) as error:
+    except InputError as error:
         print(f"aarecovery: error: {error}", file=sys.stderr)
+        return 1
+    except OSError as error:
+        print(f"aarecovery: error: {os_error_line(error)}", file=sys.stderr)
         return 1
     except MemoryError as error:
         # The core says how much it needed where it can (NotEnoughMemory); anything else is bare.

@@ -131,11 +131,25 @@ class _Progress:
         self.bar.close()
 
 
+def _check_paths_for_a_cluster(args, is_url):
+    """Refuse relative paths with a scheduler address: its workers resolve them from their own
+    working folders, on their own machines, not from the folder this command runs in."""
+    if not args.dask or args.dask == "local":
+        return
+    for option, path in (("ORIGINALS", args.originals), ("FILTERED", args.filtered), ("-o", args.output),
+                         ("--keep-filtered", args.keep_filtered), ("--maps", args.maps)):
+        if path is not None and not is_url(path) and not os.path.isabs(path):
+            raise InputError(f"{option} {path!r} is a relative path, and the workers of the Dask cluster at "
+                             f"{args.dask} resolve paths on their side, from their own working folders; give "
+                             f"an absolute path on storage every worker sees, such as {os.path.abspath(path)!r}")
+
+
 def run(args):
     """Run ``aarecovery batch`` with parsed arguments; return the exit status."""
     from ..batch import ImageResult, check_report_path, make_settings, run_jobs, summary, write_report
     from ..batch.storage import is_url
 
+    _check_paths_for_a_cluster(args, is_url)
     if args.workers is not None and args.workers < 1:
         raise InputError(f"--workers must be at least 1, got {args.workers}")
     if args.report:
