@@ -13,8 +13,10 @@ import numpy as np
 #: The recovered image R, by its dtype: one 8-bit level, two 16-bit levels, 1e-5 on float.
 RESULT = {np.dtype(np.uint8): 1, np.dtype(np.uint16): 2, np.dtype(np.float32): 1e-5}
 
-#: The maps (``aarecovery.RecoveryMaps``), absolute; the edge strength relative.
-MAPS = {"alpha": 1e-4, "beta": 1e-5, "residual": 1e-5, "edge_strength": 1e-5}
+#: The maps (``aarecovery.RecoveryMaps``), absolute; the edge strength relative. Beta goes
+#: through exp(), which GLSL computes within 3 + 2|x| ULP: 1.25e-5 apart measured (a noisy
+#: 33 x 16 pair under equalize, test_gl_fuzz seed 1014).
+MAPS = {"alpha": 1e-4, "beta": 1e-4, "residual": 1e-5, "edge_strength": 1e-5}
 
 #: The working-space textures (the same sRGB formula in float32), relative and absolute.
 WORKING_SPACE = (1e-6, 1e-7)
