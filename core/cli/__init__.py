@@ -17,6 +17,7 @@ from ..errors import AarecoveryWarning, InputError, NotEnoughMemory
 from ..extras import extra_for, missing_extra
 from ..gimp import cli as gimp_command
 from ..io import os_error_line
+from .text import printable
 from ..viewer import cli as view_command
 from . import batch as batch_command
 from . import bench as bench_command
@@ -103,7 +104,7 @@ def _warnings_as_lines():
 
         def show(message, category, filename, lineno, file=None, line=None):
             if issubclass(category, AarecoveryWarning):
-                print(f"aarecovery: warning: {message}", file=sys.stderr, flush=True)
+                print(f"aarecovery: warning: {printable(message)}", file=sys.stderr, flush=True)
             else:
                 shown(message, category, filename, lineno, file, line)
 
@@ -137,18 +138,18 @@ def main(argv=None):
         extra = extra_for(error)
         if extra is None:
             raise
-        print(f"aarecovery: error: {missing_extra(args.prog, extra, error)}", file=sys.stderr)
+        print(f"aarecovery: error: {printable(missing_extra(args.prog, extra, error))}", file=sys.stderr)
         return 1
     except InputError as error:
-        print(f"aarecovery: error: {error}", file=sys.stderr)
+        print(f"aarecovery: error: {printable(error)}", file=sys.stderr)
         return 1
     except OSError as error:
-        print(f"aarecovery: error: {os_error_line(error)}", file=sys.stderr)
+        print(f"aarecovery: error: {printable(os_error_line(error))}", file=sys.stderr)
         return 1
     except MemoryError as error:
         # The core says how much it needed where it can (NotEnoughMemory); anything else is bare.
         advice = "" if isinstance(error, NotEnoughMemory) else f"; try {_memory_advice(args)}"
-        print(f"aarecovery: error: {str(error) or 'out of memory'}{advice}", file=sys.stderr)
+        print(f"aarecovery: error: {printable(str(error) or 'out of memory')}{advice}", file=sys.stderr)
         return 1
     except KeyboardInterrupt as interruption:
         number = getattr(interruption, "signum", signal.SIGINT)

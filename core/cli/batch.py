@@ -2,12 +2,14 @@
 
 import argparse
 import os
+import signal
 import sys
 import time
 
 from ..errors import InputError
 from .inputs import add_image_memory_option
 from .recover import add_recovery_options
+from .text import printable
 
 __all__ = ["register", "run"]
 
@@ -175,13 +177,14 @@ def run(args):
         engine = Engine(settings.backend, gl_path=settings.gl_path)
     progress = _Progress(len(jobs))
     start = time.perf_counter()
-    interrupted = False
+    interrupted = None
     finished = []
     try:
         finished = run_jobs(jobs, settings, workers=args.workers, progress=progress, dask=args.dask, engine=engine)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as interruption:
         finished = progress.results
-        interrupted = True
+        # Ctrl+C, or SIGTERM / SIGHUP turned into an interruption by the command line.
+        interrupted = getattr(interruption, "signum", signal.SIGINT)
     finally:
         progress.close()
         if engine is not None:
@@ -190,13 +193,14 @@ def run(args):
     results = sorted(missing + list(finished), key=lambda result: result.name)
     for result in results:
         if result.status == "failed":
-            print(f"aarecovery: failed: {result.name}: {result.error}", file=sys.stderr)
+            print(f"aarecovery: failed: {printable(result.name)}: {printable(result.error)}", file=sys.stderr)
     if args.report:
         write_report(args.report, results)
-    print(summary(results, seconds) + (f"; report in {args.report}" if args.report else ""))
-    if interrupted:
-        print(f"aarecovery: interrupted after {len(progress.results)} of {len(jobs)} images; every result written "
-              "is complete: run the same command again to finish", file=sys.stderr)
-        return 130
+    print(summary(results, seconds) + (f"; report in {printable(args.report)}" if args.report else ""))
+    if interrupted is not None:
+        print(f"aarecovery: interrupted ({signal.Signals(interrupted).name}) after {len(progress.results)} of "
+              f"{len(jobs)} images; every result written is complete: run the same command again to finish",
+              file=sys.stderr)
+        return 128 + interrupted
     return 1 if any(result.status == "failed" for result in results) else 0
 
