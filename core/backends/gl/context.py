@@ -1,5 +1,7 @@
 """Making a standalone OpenGL 3.3 context, or saying clearly why there is none."""
 
+import os
+
 import moderngl
 
 from ...errors import InputError
@@ -38,6 +40,10 @@ def create_context():
     GLUnavailable
         With every attempt's reason in the message.
     """
+    # Mesa's EGL prints its warnings (a driver it could not load, a screen it could not
+    # make) straight to stderr, beside our one-line messages; the reasons that matter come
+    # back in the exception. A level the user set is kept.
+    os.environ.setdefault("EGL_LOG_LEVEL", "fatal")
     reasons = []
     for options in ({"backend": "egl"}, {}):
         try:
