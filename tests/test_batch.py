@@ -395,7 +395,8 @@ def test_ctrl_c_stops_a_running_filter_command_and_its_children(tmp_path):
     command = [sys.executable, "-m", "aarecovery", "batch", str(tmp_path / "o"), "-o", str(tmp_path / "r"),
                "--backend", "numpy", "--filter-cmd",
                f"sh -c 'touch {started}; sleep 6 && touch {marker} & wait' {{in}} {{out}}"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
+                               preexec_fn=default_signal_dispositions)
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline and not started.exists():
         time.sleep(0.05)

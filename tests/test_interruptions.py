@@ -29,8 +29,11 @@ _STALLED_WRITER = textwrap.dedent("""
         time.sleep(60)
 
     write._encode = stalled
-    if os.environ.get("TEST_NOHUP"):
-        signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    # The dispositions a terminal gives, or nohup's, whatever this test run inherited (under
+    # nohup SIGHUP arrives ignored, in a background job SIGINT).
+    signal.signal(signal.SIGHUP, signal.SIG_IGN if os.environ.get("TEST_NOHUP") else signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     sys.exit(main(sys.argv[1:]))
 """)
 
