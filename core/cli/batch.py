@@ -1,6 +1,7 @@
 """``aarecovery batch``: many image pairs, or originals and a filter, with one engine."""
 
 import argparse
+import logging
 import os
 import signal
 import sys
@@ -133,6 +134,33 @@ class _Progress:
         self.bar.close()
 
 
+class _DaskLogLines(logging.Handler):
+    """Dask's log records as our one-line messages: ``aarecovery: dask: warning: ...``, the
+    first line of each (Dask's own format is a time stamp, a logger name, and at times a
+    traceback)."""
+
+    def emit(self, record):
+        lines = record.getMessage().strip().splitlines() or [""]
+        more = f" (+{len(lines) - 1} lines)" if len(lines) > 1 else ""
+        print(f"aarecovery: dask: {record.levelname.lower()}: {printable(lines[0])}{more}", file=sys.stderr)
+
+
+def dask_logs_as_lines():
+    """Route the ``distributed`` loggers of this process through :class:`_DaskLogLines`, and
+    keep the worker processes it starts to errors (their stderr is this terminal too)."""
+    try:
+        import distributed  # noqa: F401  (configures its loggers, which are replaced here)
+    except ImportError:
+        return  # connect() says how to install it
+    logger = logging.getLogger("distributed")
+    for handler in list(logger.handlers):
+        logger.removeHandler(handler)
+    logger.addHandler(_DaskLogLines(logging.WARNING))  # its info lines are a cluster's chatter
+    logger.propagate = False
+    # Read by each worker process's Dask configuration as it starts (after this import).
+    os.environ.setdefault("DASK_LOGGING__DISTRIBUTED", "error")
+
+
 def _check_paths_for_a_cluster(args, is_url):
     """Refuse relative paths with a scheduler address: its workers resolve them from their own
     working folders, on their own machines, not from the folder this command runs in."""
@@ -152,6 +180,8 @@ def run(args):
     from ..batch.storage import is_url
 
     _check_paths_for_a_cluster(args, is_url)
+    if args.dask:
+        dask_logs_as_lines()
     if args.workers is not None and args.workers < 1:
         raise InputError(f"--workers must be at least 1, got {args.workers}")
     if args.report:
