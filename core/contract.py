@@ -12,7 +12,7 @@ import numpy as np
 
 from .errors import InputError
 
-__all__ = ["Layout", "layout_of", "check_values", "to_rgba_float", "from_rgba_float", "check_same_size"]
+__all__ = ["Layout", "native_byte_order", "layout_of", "check_values", "to_rgba_float", "from_rgba_float", "check_same_size"]
 
 _SHAPES = "(H, W) grey, (H, W, 1) grey, (H, W, 2) grey+alpha, (H, W, 3) RGB or (H, W, 4) RGBA"
 _DTYPES = "uint8, uint16 or a float dtype with values in [0, 1]"
@@ -53,6 +53,14 @@ class Layout:
     @property
     def channels(self):
         return 1 if len(self.shape) == 2 else self.shape[2]
+
+
+def native_byte_order(image):
+    """`image` with its samples in this machine's byte order (a big-endian ``>u2`` array, as
+    FITS and some TIFF readers give, copied to ``uint16``); anything else unchanged."""
+    if isinstance(image, np.ndarray) and not image.dtype.isnative:
+        return image.astype(image.dtype.newbyteorder("="))
+    return image
 
 
 def layout_of(image, name):

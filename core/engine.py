@@ -4,7 +4,7 @@ import time
 
 from .backends import make_backend
 from .backends.base import RecoveryMaps
-from .contract import check_same_size, from_rgba_float, layout_of
+from .contract import check_same_size, from_rgba_float, layout_of, native_byte_order
 from .errors import InputError
 from .params import DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, STRENGTH, Parameters, check_blend_space
 from .plan import analyse_pair, make_plan
@@ -101,6 +101,7 @@ class Engine:
             On a shape, dtype, size mismatch, NaN or range the core cannot use.
         """
         self._require_unreleased()
+        original, filtered = native_byte_order(original), native_byte_order(filtered)
         o_layout = layout_of(original, "original")
         f_layout = layout_of(filtered, "filtered")
         check_same_size(o_layout, f_layout)

@@ -17,7 +17,8 @@ class AarecoveryWarning(UserWarning):
 
 
 class BackendFallbackWarning(AarecoveryWarning, RuntimeWarning):
-    """``backend="auto"`` found no OpenGL 3.3 and runs the NumPy backend (same result, slower)."""
+    """``backend="auto"`` found no OpenGL 3.3 and runs the NumPy backend (the same
+    result up to float rounding, slower)."""
 
 
 class OrderWarning(AarecoveryWarning):

@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 
 from .backends.base import RecoveryMaps
-from .contract import check_same_size, check_values, from_rgba_float, layout_of
+from .contract import check_same_size, check_values, from_rgba_float, layout_of, native_byte_order
 from .engine import Engine
 from .errors import NotEnoughMemory, OrderWarning
 from .memory import not_enough_memory
@@ -104,6 +104,7 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     >>> aarecovery.recover(o, f, backend="numpy").shape
     (8, 8)
     """
+    original, filtered = native_byte_order(original), native_byte_order(filtered)
     o_layout = layout_of(original, "original")
     f_layout = layout_of(filtered, "filtered")
     check_same_size(o_layout, f_layout)

@@ -3,7 +3,8 @@
 ``--backend numpy|gl|all`` picks which backends the backend-parametrised tests run on
 (kornia-style: every such test body runs once per backend), and ``--gl-path
 fragment|compute|all`` which GL paths the tests taking ``gl_path`` run on (module-scoped,
-so that a module's engine is made once per path). GL tests never skip quietly: when no
+so that a module's engine is made once per path), and ``--parity-cases N`` / ``--parity-seed
+S`` how many random GL/NumPy cases ``test_gl_fuzz.py`` draws and from which seed. GL tests never skip quietly: when no
 OpenGL context can be made they fail in CI (CI=true) and skip loudly elsewhere.
 """
 
@@ -20,6 +21,10 @@ def pytest_addoption(parser):
                      help="run backend-parametrised tests on this backend only (default: all)")
     parser.addoption("--gl-path", default="all", choices=("all",) + GL_PATH_NAMES,
                      help="run GL-path-parametrised tests on this path only (default: all)")
+    parser.addoption("--parity-cases", type=int, default=int(os.environ.get("AARECOVERY_PARITY_CASES", 24)),
+                     help="random cases of tests/test_gl_fuzz.py per GL path (default: 24, or "
+                          "$AARECOVERY_PARITY_CASES)")
+    parser.addoption("--parity-seed", type=int, default=0, help="the first seed of tests/test_gl_fuzz.py's cases")
 
 
 def pytest_generate_tests(metafunc):

@@ -182,6 +182,13 @@ def results(folder):
     return sorted(path.name for path in folder.glob("*.png") if not path.name.startswith("."))
 
 
+def default_signal_dispositions():
+    """In a child, before exec: the dispositions a terminal gives, whatever this test run
+    inherited (under nohup SIGHUP is ignored, in a background job SIGINT)."""
+    for number in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(number, signal.SIG_DFL)
+
+
 def _batch_command(tmp_path, *extra):
     return [sys.executable, "-m", "aarecovery", "batch", str(tmp_path / "o"), str(tmp_path / "f"), "-o",
             str(tmp_path / "r"), "--backend", "numpy", "--workers", "1", *extra]
@@ -190,7 +197,7 @@ def _batch_command(tmp_path, *extra):
 def _interrupt_after_first_results(tmp_path, signal_number):
     # A session of its own, so that SIGINT reaches the whole process group, as Ctrl+C does.
     process = subprocess.Popen(_batch_command(tmp_path), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               start_new_session=True)
+                               start_new_session=True, preexec_fn=default_signal_dispositions)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and process.poll() is None:
         if len(results(tmp_path / "r")) >= 2:
@@ -204,17 +211,22 @@ def _interrupt_after_first_results(tmp_path, signal_number):
     return process.returncode, out.decode(), err.decode()
 
 
-@pytest.mark.parametrize("signal_number", [signal.SIGINT, signal.SIGKILL])
+@pytest.mark.parametrize("signal_number", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGKILL])
 def test_an_interrupted_batch_leaves_only_complete_results_and_resumes(tmp_path, signal_number):
     pairs = write_numbered_pairs(tmp_path, 8, 96)
     names = sorted(pairs)
     status, out, err = _interrupt_after_first_results(tmp_path, signal_number)
     written = results(tmp_path / "r")
     assert 2 <= len(written) < len(names), (status, out, err)
-    if signal_number == signal.SIGINT:
-        assert status == 130 and "interrupted after" in err and "run the same command again" in err
+    if signal_number != signal.SIGKILL:
+        assert status == 128 + signal_number, err
+        assert f"interrupted ({signal.Signals(signal_number).name}) after" in err, err
+        assert "run the same command again" in err and "Traceback" not in err
         assert no_temporary_files(tmp_path) == []
     else:
+        # Its analysis processes find the batch gone and end quietly (communicate() read
+        # their stderr to its end: they have exited).
+        assert "Traceback" not in err and "BrokenPipeError" not in err, err
         # A killed process cannot tidy up: leave a temporary file as it would (its write
         # was cut short), older than the next run.
         stale = tmp_path / "r" / f".{names[-1][:-4]}.x1y2.part.png"
@@ -332,6 +344,14 @@ def test_a_filter_command_that_runs_too_long_is_stopped_and_reported(tmp_path, c
     assert not (tmp_path / "r" / "a.png").exists() and no_temporary_files(tmp_path) == []
 
 
+def test_a_filter_command_printing_a_10_mb_line_is_reported_in_a_short_line(tmp_path, capsys):
+    write_pairs(tmp_path, ["a.png"])
+    status, out, err = run_batch(capsys, tmp_path / "o", "-o", tmp_path / "r", "--backend", "numpy", "--filter-cmd",
+                                 "python3 -c 'import sys; sys.stderr.write(\"x\" * 10**7); sys.exit(3)' {in} {out}")
+    assert status == 1 and "exited with status 3" in err and "more characters" in err
+    assert len(err) < 1000, len(err)
+
+
 def test_max_image_memory_is_the_limit_of_each_image_read(tmp_path, capsys):
     """A file declaring more than the limit fails alone, with the option that raises it."""
     write_pairs(tmp_path, ["small.png"])
@@ -375,7 +395,8 @@ def test_ctrl_c_stops_a_running_filter_command_and_its_children(tmp_path):
     command = [sys.executable, "-m", "aarecovery", "batch", str(tmp_path / "o"), "-o", str(tmp_path / "r"),
                "--backend", "numpy", "--filter-cmd",
                f"sh -c 'touch {started}; sleep 6 && touch {marker} & wait' {{in}} {{out}}"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
+                               preexec_fn=default_signal_dispositions)
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline and not started.exists():
         time.sleep(0.05)
@@ -388,3 +409,31 @@ def test_ctrl_c_stops_a_running_filter_command_and_its_children(tmp_path):
     time.sleep(6.5 - (time.monotonic() - interrupted))
     assert not marker.exists(), "a child of the filter command went on running after Ctrl+C"
     assert no_temporary_files(tmp_path) == []
+
+
+def test_relative_paths_with_a_dask_scheduler_address_are_refused_saying_where_they_resolve(tmp_path, capsys,
+                                                                                          monkeypatch):
+    write_pairs(tmp_path, ["a.png"])
+    monkeypatch.chdir(tmp_path)
+    status, _, err = run_batch(capsys, "o", "f", "-o", tmp_path / "r", "--dask", "tcp://127.0.0.1:9")
+    assert status == 1 and err.count("\n") == 1, err
+    assert "'o' is a relative path" in err and "resolve paths on their side" in err and str(tmp_path / "o") in err
+
+
+def test_file_names_that_are_not_utf8_or_hold_control_characters_are_reported_escaped(tmp_path, capsys):
+    """A name with an invalid UTF-8 byte ended the batch in a traceback while writing the
+    report; escape sequences and newlines in names reached the terminal raw."""
+    folder = tmp_path / "o"
+    folder.mkdir()
+    image = shapes(40, seed=1)
+    write_image(folder / "plain.png", image)
+    (folder / "plain.png").rename(os.fsdecode(os.fsencode(str(folder)) + b"/bad\xff.png"))
+    broken = "esc\x1b[31mred\nline.png"
+    (folder / broken).write_bytes(b"not an image")
+    status, out, err = run_batch(capsys, folder, "-o", tmp_path / "r", "--filter", "threshold", "--backend",
+                                 "numpy", "--report", tmp_path / "report.csv")
+    assert status == 1 and "Traceback" not in err, err
+    assert "\x1b" not in out + err and "\\x1b[31mred\\nline.png" in err
+    assert err.count("\n") == 1 and out.count("\n") == 1
+    report = (tmp_path / "report.csv").read_text(encoding="utf-8")
+    assert "bad\\udcff.png,done" in report

@@ -98,3 +98,21 @@ def test_a_worker_killed_in_the_middle_of_the_batch_loses_no_result(tmp_path, cl
         np.testing.assert_array_equal(aarecovery.read_image(tmp_path / "r" / name),
                                       aarecovery.recover(*pair, backend="numpy"))
     assert no_temporary_files(tmp_path) == []
+
+
+def test_dask_logs_are_one_line_messages(capsys, monkeypatch):
+    """A worker restarted by its nanny printed Dask's own '2026-... - distributed.nanny -
+    WARNING - Restarting worker' among our lines; a record with a traceback, many lines."""
+    import logging
+
+    from aarecovery.cli.batch import dask_logs_as_lines
+    logger = logging.getLogger("distributed")
+    monkeypatch.setattr(logger, "handlers", list(logger.handlers))
+    monkeypatch.setattr(logger, "propagate", logger.propagate)
+    monkeypatch.delenv("DASK_LOGGING__DISTRIBUTED", raising=False)
+    dask_logs_as_lines()
+    logging.getLogger("distributed.nanny").warning("Restarting worker (status=Status.running)")
+    logging.getLogger("distributed.worker").error("Compute failed\nTraceback (most recent call last):\n  File x")
+    err = capsys.readouterr().err
+    assert err.splitlines() == ["aarecovery: dask: warning: Restarting worker (status=Status.running)",
+                                "aarecovery: dask: error: Compute failed (+2 lines)"]

@@ -176,3 +176,16 @@ def test_read_only_folder_names_the_folder(read_only_folder):
 def test_disk_errors_are_os_errors_and_input_errors_are_not():
     assert issubclass(DiskError, OSError) and not issubclass(DiskError, InputError)
     assert aarecovery.write_image is write_image
+
+
+def test_batch_destinations_on_a_read_only_disk_are_one_line_without_errno(tmp_path, capsys, read_only_folder):
+    originals = tmp_path / "originals"
+    originals.mkdir()
+    write_image(originals / "a.png", ramp_pair()[0])
+    for destination in (["-o", read_only_folder / "new"], ["-o", tmp_path / "r1", "--report", read_only_folder / "r.csv"],
+                        ["-o", tmp_path / "r2", "--keep-filtered", read_only_folder / "kept"]):
+        status, _, err = run_main(capsys, "batch", originals, "--filter", "threshold", "--backend", "numpy",
+                                  *destination)
+        assert status == 1, err
+        assert "Errno" not in err and "Traceback" not in err, err
+        assert str(read_only_folder) in err

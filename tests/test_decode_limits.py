@@ -167,3 +167,11 @@ def test_refusal_is_quick_in_process(tmp_path):
     with pytest.raises(InputError):
         read_image(path)
     assert time.perf_counter() - start < 2
+
+
+@pytest.mark.parametrize("value", ["0", "-2", "eight", "inf"])
+def test_a_limit_that_is_not_a_positive_number_says_so(capsys, value):
+    with pytest.raises(SystemExit):
+        main(["recover", "o.png", "f.png", "-o", "r.png", "--max-image-memory", value])
+    err = capsys.readouterr().err
+    assert "a positive number of GB is needed" in err and repr(value) in err and "_gigabytes" not in err

@@ -38,3 +38,13 @@ def test_demo_on_a_small_user_image_has_no_reference(tmp_path):
     outcome = run_demo(image, str(tmp_path), backend="numpy")
     assert all(gain is None for gain in outcome["gains"].values())
     assert os.path.exists(outcome["sheet"])
+
+
+def test_demo_of_a_large_user_image_says_that_it_shrinks_it(tmp_path, capsys):
+    from aarecovery import write_image
+    write_image(tmp_path / "mine.png", (np.random.default_rng(0).random((300, 320, 3)) * 255).astype(np.uint8))
+    assert main(["demo", str(tmp_path / "mine.png"), "-o", str(tmp_path / "demo"), "--backend", "numpy"]) == 0
+    out = capsys.readouterr().out
+    assert "(320x300) was shrunk 4x to 80x75" in out
+    with Image.open(tmp_path / "demo" / "O.png") as image:
+        assert image.size == (80, 75)

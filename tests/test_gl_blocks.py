@@ -10,6 +10,7 @@ import pytest
 import aarecovery
 from aarecovery.backends.gl.blocks import LISTS, active_blocks, active_mask, block_lists, expand_runs
 from gl_blocks import dispatch_sizes, gpu_lists
+from parity import assert_results_agree
 
 pytestmark = pytest.mark.gl
 
@@ -100,7 +101,6 @@ def test_long_lists_dispatch_in_rows(compute_classification):
             for mode in ("paper", "safe"):
                 actual = aarecovery.recover(original, filtered, engine=engine, mode=mode)
                 expected = aarecovery.recover(original, filtered, backend="numpy", mode=mode)
-                tolerance = {np.dtype(np.uint8): 1, np.dtype(np.uint16): 2}.get(actual.dtype, 1e-5)
-                assert np.abs(actual.astype(np.float64) - expected).max() <= tolerance
+                assert_results_agree(actual, expected)
     finally:
         engine.release()

@@ -22,6 +22,8 @@ TWINS = {
     ("pure_colours.glsl", "MIN_REACH"): pure_colours.MIN_REACH,
     ("blend_model.glsl", "TINY"): float(blend_model._TINY),
     ("blend_model.glsl", "FAINT"): float(blend_model._FAINT),
+    ("blend_model.glsl", "SPREAD_TIE"): float(blend_model.SPREAD_TIE),
+    ("blend_model.glsl", "SPREAD_TIE_FLOOR"): float(blend_model.SPREAD_TIE_FLOOR),
     ("classify_blocks.comp", "MARGIN"): blocks.MARGIN,
     ("classify_blocks.comp", "BLOCK_SIDE"): blocks.BLOCK_SIDE,
     ("classify_blocks.frag", "MARGIN"): blocks.MARGIN,

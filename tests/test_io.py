@@ -290,7 +290,41 @@ def test_npy_of_wrong_dtype_or_shape(tmp_path, array, word):
 
 def test_npy_of_objects_is_refused_without_unpickling(tmp_path):
     np.save(tmp_path / "objects.npy", np.array([[{}]], dtype=object), allow_pickle=True)
-    assert_input_error(lambda: read_image(tmp_path / "objects.npy"), "objects.npy", "could not decode")
+    message = assert_input_error(lambda: read_image(tmp_path / "objects.npy"), "objects.npy", "pickled")
+    assert "complete" not in message
+
+
+def _npy_header_only(path, shape, dtype="|u1"):
+    with open(path, "wb") as file:
+        np.lib.format.write_array_header_1_0(file, {"descr": dtype, "fortran_order": False, "shape": shape})
+
+
+@pytest.mark.parametrize("shape", [(10 ** 10,), (50000, 50000, 4, 1)])
+def test_npy_shape_is_refused_from_its_header_before_anything_is_allocated(tmp_path, shape):
+    # A 1-D or 4-D array claiming gigabytes: refused by its shape, not "Unable to allocate".
+    _npy_header_only(tmp_path / "array.npy", shape)
+    message = assert_input_error(lambda: read_image(tmp_path / "array.npy"), str(shape), "(H, W)")
+    assert "\n" not in message and "complete" not in message
+
+
+def test_npy_with_a_huge_header_is_one_line(tmp_path):
+    with open(tmp_path / "header.npy", "wb") as file:
+        file.write(b"\x93NUMPY\x02\x00" + (50_000_000).to_bytes(4, "little") + b"{" + b" " * 1000)
+    message = assert_input_error(lambda: read_image(tmp_path / "header.npy"), "header.npy", "50000000 bytes")
+    assert "\n" not in message
+
+
+def test_read_image_of_none_is_an_input_error():
+    assert_input_error(lambda: read_image(None), "NoneType")
+
+
+def test_big_endian_arrays_are_recovered_as_native(backend):
+    image = random_image((16, 20, 3), np.uint16)
+    filtered = np.where(image > 30000, 65535, 0).astype(np.uint16)
+    expected = aarecovery.recover(image, filtered, backend=backend)
+    swapped = aarecovery.recover(image.astype(">u2"), filtered.astype(">u2"), backend=backend)
+    assert swapped.dtype == np.uint16
+    np.testing.assert_array_equal(swapped, expected)
 
 
 def bmp_claiming_size(path, width, height):
@@ -466,3 +500,22 @@ def test_a_flipped_or_strided_view_is_written(tmp_path):
     for name, view in (("flipped.png", image[:, ::-1]), ("channel.png", image[..., 1]), ("every-other.tif", image[::2])):
         write_image(tmp_path / name, view)
         np.testing.assert_array_equal(read_image(tmp_path / name), view)
+
+
+def test_a_codec_that_cannot_load_for_lack_of_memory_is_not_called_a_broken_file(tmp_path):
+    # A process at its memory limit cannot map imagecodecs' PNG library; imagecodecs reports
+    # that as "could not import name 'png_decode'", which read as a corrupt file before.
+    write_image(tmp_path / "small.png", np.zeros((8, 8, 3), np.uint8))
+    script = (
+        "import resource, sys, aarecovery\n"
+        "import imagecodecs\n"
+        "size = int(open('/proc/self/statm').read().split()[0]) * resource.getpagesize()\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (size, resource.RLIM_INFINITY))\n"
+        "try:\n"
+        "    aarecovery.read_image(sys.argv[1])\n"
+        "except BaseException as error:\n"
+        "    print(type(error).__name__, error)\n")
+    result = subprocess.run([sys.executable, "-c", script, str(tmp_path / "small.png")], capture_output=True,
+                            text=True, timeout=60)
+    assert result.stdout.startswith("NotEnoughMemory could not load the PNG decoder"), result
+    assert "complete?" not in result.stdout and "out of memory" in result.stdout

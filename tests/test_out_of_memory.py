@@ -75,3 +75,13 @@ def test_decoding_out_of_memory_does_not_blame_the_file(tmp_path):
     done = run_limited(4, "filter", "gamma", tmp_path / "noise.png", "-o", tmp_path / "out.png")
     line = one_line(done)
     assert "decode" in line and "noise.png" in line and "is the file complete" not in line
+
+
+def test_out_of_memory_advice_names_only_options_the_command_has(tmp_path):
+    # The filter itself (a float copy of the image) runs out: no tiles, no recovery backend.
+    noise = np.random.default_rng(1).integers(0, 256, (2048, 2048, 3), dtype=np.uint8)
+    write_image(tmp_path / "noise.png", noise)
+    done = run_limited(30, "filter", "gamma", tmp_path / "noise.png", "-o", tmp_path / "out.png")
+    assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+    (line,) = done.stderr.splitlines()
+    assert "--tile-size" not in line and "--backend" not in line and "more memory" in line

@@ -121,13 +121,15 @@ def _files_section(app):
     imgui.text_colored(_DIM, "or drop files on the window")
 
 
-def _slider(app, key, label, value, minimum, maximum, display_format, flags=0, help_text=None):
+def _slider(app, key, label, value, minimum, maximum, display_format, flags=0, help_text=None, indent=0.0):
     """A slider with its value beside the track, where the grab cannot cover it.
 
     ImGui draws a slider's value centred on the track, under which the grab passes and hid
     digits. Here the frame draws nothing (ImGui shows no text after ``##``; ctrl+click
     editing and the rounding of dragged values still use the format after it) and the value
     is a text item between the track and the label, whose column fits the widest value.
+    `indent` is what an item before it on the same line took (the strength's "auto" box):
+    the track is that much shorter, so that the label ends where the others do.
 
     Returns
     -------
@@ -135,7 +137,7 @@ def _slider(app, key, label, value, minimum, maximum, display_format, flags=0, h
     """
     style = imgui.get_style()
     start_x = imgui.get_cursor_pos_x()
-    width = imgui.calc_item_width()
+    width = imgui.calc_item_width() - indent
     spacing = style.item_inner_spacing.x
     column = max(imgui.calc_text_size(_VALUE_COLUMN).x, imgui.calc_text_size(display_format % value).x)
     imgui.set_next_item_width(max(1.0, width - column - spacing))
@@ -149,6 +151,8 @@ def _slider(app, key, label, value, minimum, maximum, display_format, flags=0, h
     app.widget_rects[f"{key} value"] = (low.x, low.y, high.x, high.y)
     imgui.same_line(max(start_x + width + spacing, imgui.get_cursor_pos_x()))
     imgui.text(label)
+    low, high = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+    app.widget_rects[f"{key} label"] = (low.x, low.y, high.x, high.y)
     if help_text and (hovered or imgui.is_item_hovered()):
         imgui.set_tooltip(help_text)
     return value
@@ -161,7 +165,9 @@ def _parameter_slider(app, spec, value):
     "auto" box first: ticked, the value is None and the status line says what was chosen;
     unticked, the slider starts at what the last run used.
     """
+    indent = 0.0
     if spec.automatic:
+        line_start = imgui.get_cursor_pos_x()
         automatic = value is None
         changed, automatic = imgui.checkbox(f"auto##{spec.name}", automatic)
         _record(app, f"{spec.name} auto")
@@ -174,11 +180,12 @@ def _parameter_slider(app, spec, value):
         if value is None:
             plan = app.recovery.engine.last_plan if app.recovery.engine is not None else None
             value = plan.strength if plan is not None else spec.maximum
+        indent = imgui.get_cursor_pos_x() - line_start
     flags = imgui.SliderFlags_.always_clamp
     if spec.logarithmic:
         flags |= imgui.SliderFlags_.logarithmic
     return _slider(app, spec.name, spec.label, value, spec.minimum, spec.maximum,
-                   "%d" if spec.kind is int else _FLOAT_FORMAT, flags, spec.help)
+                   "%d" if spec.kind is int else _FLOAT_FORMAT, flags, spec.help, indent)
 
 
 def _parameters_section(app):

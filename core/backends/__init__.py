@@ -62,6 +62,6 @@ def make_backend(name="auto", context=None, gl_path="auto"):
     except GLUnavailable as error:
         if name == "gl":
             raise
-        warnings.warn(f"no OpenGL 3.3 context ({error.reason}); using the NumPy backend (the same result, "
-                      "slower)", BackendFallbackWarning, stacklevel=3)
+        warnings.warn(f"no OpenGL 3.3 context ({error.reason}); using the NumPy backend (the same result "
+                      "up to float rounding, slower)", BackendFallbackWarning, stacklevel=3)
         return _numpy()

@@ -26,6 +26,8 @@ __all__ = ["BuiltinFilter", "FilterCommand", "FilterFailed"]
 
 # The last lines of a failing tool's stderr that are reported (a tool may print pages).
 _STDERR_LINES = 3
+# ... and of each line, so that a tool printing one 10 MB line gives a readable error.
+_STDERR_LINE_CHARACTERS = 200
 
 
 class FilterFailed(InputError):
@@ -113,9 +115,7 @@ class FilterCommand:
         target = output if chosen else produced
         words = [word.replace("{in}", copy).replace("{out}", target) for word in self.words()]
         returncode, stderr = _run_as_group(words, self.timeout, folder, self.template)
-        # Without terminal colour codes (G'MIC colours its messages).
-        text = re.sub(r"\x1b\[[0-9;]*m", "", stderr.decode(errors="replace"))
-        message = " | ".join(line.strip() for line in text.strip().splitlines()[-_STDERR_LINES:])
+        message = _tool_message(stderr)
         if returncode != 0:
             raise FilterFailed(f"the filter command exited with status {returncode}"
                                + (f": {message}" if message else "") + f" ({self.template})")
@@ -123,6 +123,19 @@ class FilterCommand:
             raise FilterFailed(f"the filter command wrote no {os.path.basename(produced)} ({self.template})"
                                + (f": {message}" if message else ""))
         return produced
+
+
+def _cut(line):
+    if len(line) <= _STDERR_LINE_CHARACTERS:
+        return line
+    return f"{line[:_STDERR_LINE_CHARACTERS]}... ({len(line) - _STDERR_LINE_CHARACTERS} more characters)"
+
+
+def _tool_message(stderr):
+    """The last lines of a tool's stderr, each cut, as one line."""
+    # Without terminal colour codes (G'MIC colours its messages).
+    text = re.sub(r"\x1b\[[0-9;]*m", "", stderr.decode(errors="replace"))
+    return " | ".join(_cut(line.strip()) for line in text.strip().splitlines()[-_STDERR_LINES:])
 
 
 # The filter commands running now, each its own process group: a new session does not get

@@ -53,13 +53,26 @@ def serve(requests=None, replies=None):
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     requests = requests or sys.stdin.buffer
     replies = replies or sys.stdout.buffer
-    while (request := _receive(requests)) is not None:
-        original, filtered, parameters, options = request
-        try:
-            reply = (True, make_plan(original, filtered, parameters, **options))
-        except Exception as error:  # handed back to the batch, which fails that image
-            reply = (False, error)
-        _send(replies, reply)
+    try:
+        while (request := _receive(requests)) is not None:
+            original, filtered, parameters, options = request
+            try:
+                reply = (True, make_plan(original, filtered, parameters, **options))
+            except Exception as error:  # handed back to the batch, which fails that image
+                reply = (False, error)
+            _send(replies, reply)
+    except (BrokenPipeError, EOFError, pickle.UnpicklingError):
+        # The batch is gone (killed, even with SIGKILL, mid-request or mid-reply): nobody
+        # reads the answer, so stop without a traceback on the terminal it shared.
+        _stop_quietly(replies)
+
+
+def _stop_quietly(replies):
+    """Point `replies` at /dev/null, so that the flush at exit does not raise on the broken pipe."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), replies.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 class PlannerProcesses:

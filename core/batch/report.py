@@ -35,7 +35,8 @@ def write_report(path, results):
     rows = [_row(result) for result in results]
     temporary = f"{path}.part"
     try:
-        with open(temporary, "w", newline="") as out:
+        # A file name that is not UTF-8 (os.fsdecode's surrogates) is written escaped (\udcff).
+        with open(temporary, "w", newline="", encoding="utf-8", errors="backslashreplace") as out:
             if path.lower().endswith(".json"):
                 json.dump(rows, out, indent=1)
                 out.write("\n")

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, fields
 from .. import stream
 from ..contract import check_same_size, check_values, layout_of
 from ..errors import InputError
-from ..io import check_output_path, read_image, write_image
+from ..io import check_output_path, os_error_line, read_image, write_image
 from ..io.maps import write_maps
 from ..params import Parameters
 from ..pipeline import recover
@@ -180,7 +180,8 @@ def _local(work, path):
 def fail(work, error):
     """Mark `work` failed with `error` (one line; an unexpected error says so) and finish it."""
     work.result.status = "failed"
-    work.result.error = str(error) if isinstance(error, (InputError, OSError)) else \
+    work.result.error = os_error_line(error) if isinstance(error, OSError) else str(error) if isinstance(
+        error, InputError) else \
         f"{type(error).__name__}: {error} (an internal error; please report it)"
     work.finished()
     return work

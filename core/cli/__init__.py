@@ -16,6 +16,8 @@ from .. import __version__
 from ..errors import AarecoveryWarning, InputError, NotEnoughMemory
 from ..extras import extra_for, missing_extra
 from ..gimp import cli as gimp_command
+from ..io import os_error_line
+from .text import printable
 from ..viewer import cli as view_command
 from . import batch as batch_command
 from . import bench as bench_command
@@ -102,13 +104,24 @@ def _warnings_as_lines():
 
         def show(message, category, filename, lineno, file=None, line=None):
             if issubclass(category, AarecoveryWarning):
-                print(f"aarecovery: warning: {message}", file=sys.stderr, flush=True)
+                print(f"aarecovery: warning: {printable(message)}", file=sys.stderr, flush=True)
             else:
                 shown(message, category, filename, lineno, file, line)
 
         warnings.showwarning = show
         warnings.filterwarnings("default", category=AarecoveryWarning)
         yield
+
+
+def _memory_advice(args):
+    """What may help a command that ran out of memory: only the options it has, and the
+    backend only where it recovers (``filter`` without ``--recover`` does not)."""
+    advice = []
+    if getattr(args, "tile_size", False) is not False:
+        advice.append("a smaller --tile-size")
+    if getattr(args, "backend", "numpy") != "numpy" and getattr(args, "recover", True):
+        advice.append("--backend numpy")
+    return ", ".join(advice + ["closing other programs or a machine with more memory"])
 
 
 def main(argv=None):
@@ -125,15 +138,18 @@ def main(argv=None):
         extra = extra_for(error)
         if extra is None:
             raise
-        print(f"aarecovery: error: {missing_extra(args.prog, extra, error)}", file=sys.stderr)
+        print(f"aarecovery: error: {printable(missing_extra(args.prog, extra, error))}", file=sys.stderr)
         return 1
-    except (InputError, OSError) as error:
-        print(f"aarecovery: error: {error}", file=sys.stderr)
+    except InputError as error:
+        print(f"aarecovery: error: {printable(error)}", file=sys.stderr)
+        return 1
+    except OSError as error:
+        print(f"aarecovery: error: {printable(os_error_line(error))}", file=sys.stderr)
         return 1
     except MemoryError as error:
         # The core says how much it needed where it can (NotEnoughMemory); anything else is bare.
-        print(f"aarecovery: error: {str(error) or 'out of memory'}" + ("" if isinstance(error, NotEnoughMemory) else
-              "; try a smaller --tile-size, --backend numpy, or a machine with more memory"), file=sys.stderr)
+        advice = "" if isinstance(error, NotEnoughMemory) else f"; try {_memory_advice(args)}"
+        print(f"aarecovery: error: {printable(str(error) or 'out of memory')}{advice}", file=sys.stderr)
         return 1
     except KeyboardInterrupt as interruption:
         number = getattr(interruption, "signum", signal.SIGINT)

@@ -1,13 +1,16 @@
 """``aarecovery batch``: many image pairs, or originals and a filter, with one engine."""
 
 import argparse
+import logging
 import os
+import signal
 import sys
 import time
 
 from ..errors import InputError
 from .inputs import add_image_memory_option
 from .recover import add_recovery_options
+from .text import printable
 
 __all__ = ["register", "run"]
 
@@ -131,11 +134,54 @@ class _Progress:
         self.bar.close()
 
 
+class _DaskLogLines(logging.Handler):
+    """Dask's log records as our one-line messages: ``aarecovery: dask: warning: ...``, the
+    first line of each (Dask's own format is a time stamp, a logger name, and at times a
+    traceback)."""
+
+    def emit(self, record):
+        lines = record.getMessage().strip().splitlines() or [""]
+        more = f" (+{len(lines) - 1} lines)" if len(lines) > 1 else ""
+        print(f"aarecovery: dask: {record.levelname.lower()}: {printable(lines[0])}{more}", file=sys.stderr)
+
+
+def dask_logs_as_lines():
+    """Route the ``distributed`` loggers of this process through :class:`_DaskLogLines`, and
+    keep the worker processes it starts to errors (their stderr is this terminal too)."""
+    try:
+        import distributed  # noqa: F401  (configures its loggers, which are replaced here)
+    except ImportError:
+        return  # connect() says how to install it
+    logger = logging.getLogger("distributed")
+    for handler in list(logger.handlers):
+        logger.removeHandler(handler)
+    logger.addHandler(_DaskLogLines(logging.WARNING))  # its info lines are a cluster's chatter
+    logger.propagate = False
+    # Read by each worker process's Dask configuration as it starts (after this import).
+    os.environ.setdefault("DASK_LOGGING__DISTRIBUTED", "error")
+
+
+def _check_paths_for_a_cluster(args, is_url):
+    """Refuse relative paths with a scheduler address: its workers resolve them from their own
+    working folders, on their own machines, not from the folder this command runs in."""
+    if not args.dask or args.dask == "local":
+        return
+    for option, path in (("ORIGINALS", args.originals), ("FILTERED", args.filtered), ("-o", args.output),
+                         ("--keep-filtered", args.keep_filtered), ("--maps", args.maps)):
+        if path is not None and not is_url(path) and not os.path.isabs(path):
+            raise InputError(f"{option} {path!r} is a relative path, and the workers of the Dask cluster at "
+                             f"{args.dask} resolve paths on their side, from their own working folders; give "
+                             f"an absolute path on storage every worker sees, such as {os.path.abspath(path)!r}")
+
+
 def run(args):
     """Run ``aarecovery batch`` with parsed arguments; return the exit status."""
     from ..batch import ImageResult, check_report_path, make_settings, run_jobs, summary, write_report
     from ..batch.storage import is_url
 
+    _check_paths_for_a_cluster(args, is_url)
+    if args.dask:
+        dask_logs_as_lines()
     if args.workers is not None and args.workers < 1:
         raise InputError(f"--workers must be at least 1, got {args.workers}")
     if args.report:
@@ -161,13 +207,14 @@ def run(args):
         engine = Engine(settings.backend, gl_path=settings.gl_path)
     progress = _Progress(len(jobs))
     start = time.perf_counter()
-    interrupted = False
+    interrupted = None
     finished = []
     try:
         finished = run_jobs(jobs, settings, workers=args.workers, progress=progress, dask=args.dask, engine=engine)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as interruption:
         finished = progress.results
-        interrupted = True
+        # Ctrl+C, or SIGTERM / SIGHUP turned into an interruption by the command line.
+        interrupted = getattr(interruption, "signum", signal.SIGINT)
     finally:
         progress.close()
         if engine is not None:
@@ -176,13 +223,14 @@ def run(args):
     results = sorted(missing + list(finished), key=lambda result: result.name)
     for result in results:
         if result.status == "failed":
-            print(f"aarecovery: failed: {result.name}: {result.error}", file=sys.stderr)
+            print(f"aarecovery: failed: {printable(result.name)}: {printable(result.error)}", file=sys.stderr)
     if args.report:
         write_report(args.report, results)
-    print(summary(results, seconds) + (f"; report in {args.report}" if args.report else ""))
-    if interrupted:
-        print(f"aarecovery: interrupted after {len(progress.results)} of {len(jobs)} images; every result written "
-              "is complete: run the same command again to finish", file=sys.stderr)
-        return 130
+    print(summary(results, seconds) + (f"; report in {printable(args.report)}" if args.report else ""))
+    if interrupted is not None:
+        print(f"aarecovery: interrupted ({signal.Signals(interrupted).name}) after {len(progress.results)} of "
+              f"{len(jobs)} images; every result written is complete: run the same command again to finish",
+              file=sys.stderr)
+        return 128 + interrupted
     return 1 if any(result.status == "failed" for result in results) else 0
 

@@ -34,6 +34,12 @@ def run(args):
 
     start = time.perf_counter()
     outcome = run_demo(image, args.output, backend=args.backend, paper=args.paper)
+    if image is not None and outcome["shrunk"] is not None:
+        from ..lab.demo import MIN_SCENE_SIDE, SCENE_FACTOR
+        width, height = outcome["shrunk"]
+        print(f"{args.image} ({image.shape[1]}x{image.shape[0]}) was shrunk {SCENE_FACTOR}x to {width}x{height} "
+              f"for O: the demo treats an image of {MIN_SCENE_SIDE} px or more a side as a supersampled scene, "
+              "whose full-size filtering is the reference the gains below are measured against")
     print(f"wrote {len(outcome['files'])} images to {os.path.abspath(outcome['folder'])}/ "
           f"in {time.perf_counter() - start:.1f} s")
     print(f"comparison sheet: {os.path.abspath(outcome['sheet'])}")

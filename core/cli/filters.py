@@ -6,6 +6,7 @@ import ast
 from ..errors import InputError
 from ..params import BACKENDS, STRENGTH
 from .inputs import add_image_memory_option
+from .text import printable
 
 __all__ = ["register", "parse_params"]
 
@@ -120,7 +121,7 @@ def _run_filter(args):
         summary = summary_line(plan, image, filtered, recovered)
         filtered = recovered
     write_image(args.output, filtered)
-    print(f"wrote {args.output}")
+    print(f"wrote {printable(args.output)}")
     if summary is not None:
         print(summary)
     return 0

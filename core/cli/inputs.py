@@ -1,5 +1,7 @@
 """How commands read images: the memory limit option, and what a size mismatch may mean."""
 
+import argparse
+
 from ..contract import check_same_size, layout_of
 from ..errors import InputError
 from ..io import DEFAULT_MAX_BYTES, orientation_tag, read_image
@@ -14,7 +16,8 @@ def _gigabytes(text):
     except ValueError:
         value = float("nan")
     if not value > 0 or value == float("inf"):
-        raise InputError(f"--max-image-memory takes a positive number of GB, such as 8; got {text!r}")
+        # argparse shows an ArgumentTypeError's own words; any other error as "invalid _gigabytes value".
+        raise argparse.ArgumentTypeError(f"a positive number of GB is needed, such as 8; got {text!r}")
     return value
 
 

@@ -9,6 +9,7 @@ from ..io.maps import MAP_SCALES, map_paths, maps_as_images
 from ..params import BACKENDS, BLEND_SPACES, GL_PATHS, PARAMETERS
 from ..tiling import DEFAULT_TILES, SENSIBLE_TILE
 from .inputs import add_image_memory_option
+from .text import printable
 
 __all__ = ["register", "run", "summary_line", "add_recovery_options", "add_parameter_options", "MAP_SCALES"]
 
@@ -138,7 +139,7 @@ def run(args):
         if pair is not None:
             with pair:
                 for line in _recover_streamed(args, params, pair, engine):
-                    print(line)
+                    print(printable(line))
             return 0
         original, filtered = _read_pair(args)
         # Before the recovery, so that a long run does not end in a refusal.
@@ -166,7 +167,7 @@ def run(args):
                f"with the {backend} backend in {seconds:.2f} s")
     if args.maps is not None:
         message += f"; maps in {args.maps}"
-    print(message)
+    print(printable(message))
     print(summary_line(plan, original, filtered, result))
     return 0
 

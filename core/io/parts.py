@@ -22,8 +22,9 @@ except ImportError:  # Windows: no flock; only the age tells a stale part there
 __all__ = ["create_part", "remove_stale_parts", "is_part_name"]
 
 _PART = re.compile(r"^\.(?P<name>.+)\.[a-z0-9_]{8}\.part(?P<extension>\.[A-Za-z0-9]+)$")
-# A part younger than this is left alone even when unlocked: its writer may sit between
-# creating it and locking it (two system calls apart).
+# An empty part younger than this is left alone even when unlocked: its writer may sit
+# between creating it and locking it (two system calls apart). A part with bytes in it was
+# locked before its first byte, so its free lock means that its writer is gone, at any age.
 _MIN_AGE_SECONDS = 60.0
 # Where locks cannot be taken (Windows, some network file systems), only the age can tell:
 # no single image write takes a day.
@@ -82,8 +83,9 @@ def remove_stale_parts(folder, name=None, extension=None):
     """Remove the parts in `folder` that an interrupted write left behind.
 
     Only files named as :func:`create_part` names them are considered, and of those only the
-    ones that no living writer holds (their lock is free) and that are at least a minute old;
-    where locks are not available, only those older than a day.
+    ones that no living writer holds (their lock is free) and that hold bytes or are at least
+    a minute old (an empty one may be between its creation and its lock); where locks are not
+    available, only those older than a day.
 
     Parameters
     ----------
@@ -112,7 +114,7 @@ def remove_stale_parts(folder, name=None, extension=None):
         except OSError:
             continue
         age = now - info.st_mtime
-        if not stat.S_ISREG(info.st_mode) or age < _MIN_AGE_SECONDS:
+        if not stat.S_ISREG(info.st_mode) or (info.st_size == 0 and age < _MIN_AGE_SECONDS):
             continue
         descriptor = _writer_is_gone(entry.path, age)
         if descriptor is None:

@@ -104,6 +104,9 @@ def orientation_tag(path):
 
 def _opened(path):
     """``(path, its first 16 bytes)``, or an InputError saying why the file cannot be read."""
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise InputError(f"an image path must be a str or os.PathLike, got {type(path).__name__}; "
+                         "pass the file's name")
     path = os.fspath(path)
     if not os.path.exists(path):
         raise InputError(f"{path} does not exist; check the file name")
@@ -124,6 +127,13 @@ def _decode_error(path, format_name, error):
         # Not the file's fault: its declared size passed the limit, but this process has less.
         return NotEnoughMemory(f"not enough memory to decode {path} as {format_name} ({str(error) or 'out of memory'}); "
                                "close other programs, or use a machine with more memory")
+    if isinstance(error, ImportError):
+        # imagecodecs loads each codec on first use and reports any failure to load it, most
+        # often a process out of memory (mapping the library failed), as a missing name.
+        return NotEnoughMemory(f"could not load the {format_name} decoder to read {path} ({error}): this process "
+                               "is most likely out of memory; close other programs or raise its memory limit, "
+                               "and if memory is plentiful reinstall imagecodecs (pip install --force-reinstall "
+                               "imagecodecs)")
     detail = str(error).strip() or type(error).__name__
     return InputError(f"could not decode {path} as {format_name}: {detail}; is the file complete?")
 
@@ -143,29 +153,51 @@ def _read_png(path, max_bytes):
     return apply_orientation(image, header.orientation)
 
 
-def _read_npy(path, max_bytes):
+#: The longest ``.npy`` header read: NumPy's own limit. An image's header is about 128 bytes;
+#: a longer one is not an image (and NumPy's refusal is a paragraph).
+_NPY_HEADER_LIMIT = 10000
+
+
+def _npy_header(path):
+    """``(shape, dtype)`` from a ``.npy`` header, or an InputError saying why it is not an image."""
     try:
         with open(path, "rb") as file:
             version = np.lib.format.read_magic(file)
+            length_bytes = 2 if version == (1, 0) else 4
+            length = int.from_bytes(file.read(length_bytes), "little")
+            if length > _NPY_HEADER_LIMIT:
+                raise InputError(f"{path} has a .npy header of {length} bytes, where an image's takes about 128; "
+                                 "it is not an image array: save one with numpy.save(path, image)")
+            file.seek(0)
+            np.lib.format.read_magic(file)
             shape, _, dtype = (np.lib.format.read_array_header_1_0 if version == (1, 0)
                                else np.lib.format.read_array_header_2_0)(file)
+    except InputError:
+        raise
     except Exception as error:
         raise _decode_error(path, "a NumPy .npy array", error) from None
-    if len(shape) in (2, 3) and not dtype.hasobject:
-        check_decoded_size(path, shape, dtype, max_bytes)
+    return shape, dtype
+
+
+def _read_npy(path, max_bytes):
+    shape, dtype = _npy_header(path)
+    # Refused from the header, before anything is allocated or unpickled.
+    if dtype.hasobject:
+        raise InputError(f"{path} holds Python objects (a pickled array), which are not read for safety; "
+                         ".npy images must hold uint8, uint16, float32 or float64 numbers")
+    if dtype.newbyteorder("=") not in NPY_DTYPES:
+        raise InputError(f"{path} holds a {dtype} array; .npy images must be uint8, uint16, "
+                         "float32 or float64 (floats in [0, 1])")
+    if len(shape) not in (2, 3) or (len(shape) == 3 and not 1 <= shape[2] <= 4):
+        raise InputError(f"{path} holds an array of shape {shape}; .npy images must be (H, W) grey, "
+                         "(H, W, 2) grey+alpha, (H, W, 3) RGB or (H, W, 4) RGBA")
+    check_decoded_size(path, shape, dtype, max_bytes)
     try:
         array = np.load(path, allow_pickle=False)
     except Exception as error:
         raise _decode_error(path, "a NumPy .npy array", error) from None
-    if array.dtype.byteorder not in ("=", "|") and array.dtype.newbyteorder("=") in NPY_DTYPES:
-        array = array.astype(array.dtype.newbyteorder("="))
-    if array.dtype not in NPY_DTYPES:
-        raise InputError(f"{path} holds a {array.dtype} array; .npy images must be uint8, uint16, "
-                         "float32 or float64 (floats in [0, 1])")
-    if array.ndim not in (2, 3) or (array.ndim == 3 and not 1 <= array.shape[2] <= 4):
-        raise InputError(f"{path} holds an array of shape {array.shape}; .npy images must be (H, W) grey, "
-                         "(H, W, 2) grey+alpha, (H, W, 3) RGB or (H, W, 4) RGBA")
-    return array
+    # Big-endian arrays (saved on another machine) are read in this machine's order.
+    return array.astype(array.dtype.newbyteorder("="), copy=False)
 
 
 def _scale_to_dtype_depth(data, bits):

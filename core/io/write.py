@@ -16,7 +16,7 @@ from .parts import create_part
 from .png import write_png
 
 __all__ = ["write_image", "write_images", "check_output_path", "check_writable_folder", "DiskError",
-           "disk_error", "tiff_options"]
+           "disk_error", "os_error_line", "tiff_options"]
 
 _JPEG_QUALITY = 95
 
@@ -78,7 +78,7 @@ class DiskError(OSError):
 _SHORT_WRITE = re.compile(r"\d+ requested and \d+ written")
 
 
-def disk_error(error, folder, path=None):
+def disk_error(error, folder, path=None, nothing_written=True):
     """A :class:`DiskError` for an OSError met while writing `path` in `folder`.
 
     The message names the folder, not the hidden temporary file, and says why: full,
@@ -101,7 +101,19 @@ def disk_error(error, folder, path=None):
         message = f"{what}: no permission to create files in {folder}; choose another folder or change its permissions"
     else:
         message = f"{what}: {error.strerror or error} (in {folder})"
-    return DiskError(code, message + " (nothing was written)" if path else message)
+    return DiskError(code, message + " (nothing was written)" if path and nothing_written else message)
+
+
+def os_error_line(error):
+    """One line for an OSError met outside :func:`write_image` (a folder made, a report
+    written): a write the disk refused as :func:`disk_error` says it, anything else as
+    ``PATH: reason`` instead of Python's ``[Errno N] reason: 'PATH'``."""
+    if isinstance(error, DiskError) or error.errno is None or error.filename is None:
+        return str(error)
+    path = os.fsdecode(error.filename)
+    if error.errno in (errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC), errno.EROFS):
+        return str(disk_error(error, os.path.dirname(os.path.abspath(path)), path, nothing_written=False))
+    return f"{path}: {error.strerror or error}"
 
 
 def check_writable_folder(folder):

@@ -15,8 +15,10 @@ __all__ = ["DEMO_FILTERS", "run_demo"]
 
 #: The demo's filters: the damage users see most (hard threshold, banding, recolouring).
 DEMO_FILTERS = ("threshold", "posterize", "gradientmap")
-_K = 4
-_MIN_SCENE_SIDE = 256
+#: An image at least MIN_SCENE_SIDE a side is a supersampled scene: O is its SCENE_FACTOR x box
+#: filter, and the reference the filter applied at full size, then box-filtered the same.
+SCENE_FACTOR = 4
+MIN_SCENE_SIDE = 256
 _ZOOM = 2
 _INSET = 24
 _INSET_ZOOM = 6
@@ -88,8 +90,9 @@ def run_demo(image=None, folder="aarecovery-demo", *, backend="auto", paper=Fals
     Returns
     -------
     dict
-        ``{"folder", "sheet", "files", "gains"}``; gains maps each filter to
-        ``(edge-band PSNR of F, of R)`` in dB, or None without a reference.
+        ``{"folder", "sheet", "files", "gains", "shrunk"}``; gains maps each filter to
+        ``(edge-band PSNR of F, of R)`` in dB, or None without a reference; shrunk is
+        ``(width, height)`` of O when the image was box-filtered down to make it, else None.
     """
     from ..contract import layout_of, to_rgba_float
     from ..engine import Engine
@@ -100,15 +103,17 @@ def run_demo(image=None, folder="aarecovery-demo", *, backend="auto", paper=Fals
         scene = sample_image()
     else:
         scene = to_rgba_float(image, layout_of(image, "image"), "image")[..., :3]
-    height, width = (scene.shape[0] // _K) * _K, (scene.shape[1] // _K) * _K
-    if min(height, width) >= _MIN_SCENE_SIDE:
+    height, width = (scene.shape[0] // SCENE_FACTOR) * SCENE_FACTOR, (scene.shape[1] // SCENE_FACTOR) * SCENE_FACTOR
+    shrunk = None
+    if min(height, width) >= MIN_SCENE_SIDE:
         scene = scene[:height, :width]
-        original = box_downsample(scene, _K, "linear")
+        original = box_downsample(scene, SCENE_FACTOR, "linear")
+        shrunk = (original.shape[1], original.shape[0])
     else:
         original, scene = scene, None
     # Before anything is written: a backend that cannot run stops the demo with no files made.
     with Engine(backend) as engine:
-        return _write_demo(original, scene, folder, engine, "paper" if paper else "safe")
+        return dict(_write_demo(original, scene, folder, engine, "paper" if paper else "safe"), shrunk=shrunk)
 
 
 def _write_demo(original, scene, folder, engine, mode):
@@ -128,7 +133,7 @@ def _write_demo(original, scene, folder, engine, mode):
         reference = None
         if scene is not None:
             params = filters.FILTERS[name].defaults()
-            reference = box_downsample(filters.apply(name, scene, scale=_K, **params), _K, "linear")
+            reference = box_downsample(filters.apply(name, scene, scale=SCENE_FACTOR, **params), SCENE_FACTOR, "linear")
             band = edge_band(original, filtered, reference)
             gains[name] = (psnr(filtered, reference, band), psnr(recovered, reference, band))
         else:

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..colour import linear_to_srgb
+from ..colour import linear_to_srgb, luma
 from ..contract import layout_of, to_rgba_float
 from .analysis import analysis_crop
 from .lowpass import fit_lowpass
@@ -50,7 +50,6 @@ _ONE_PIXEL_TRANSITION = 0.8
 _HARD_BLEND_SHARE = 0.02
 _ANTIALIASED_SHARE = 0.10
 _MIN_EDGE_PIXELS = 64
-_LUMA = np.array([0.2126, 0.7152, 0.0722], np.float32)
 
 
 @dataclass(frozen=True)
@@ -120,8 +119,8 @@ def check_order(original, filtered, *, linear=False):
     OrderVerdict
     """
     o_colour, f_colour = _encoded_colour(original, linear), _encoded_colour(filtered, linear)
-    o_edges, o_blends, _ = _edge_shares(o_colour @ _LUMA)
-    f_edges, _, f_antialiased = _edge_shares(f_colour @ _LUMA)
+    o_edges, o_blends, _ = _edge_shares(luma(o_colour))
+    f_edges, _, f_antialiased = _edge_shares(luma(f_colour))
     reason = (f"order as given: blends are {o_blends:.0%} of the original's edge pixels, one-pixel blends "
               f"{f_antialiased:.0%} of the filtered image's")
     reversed_ = o_blends <= _HARD_BLEND_SHARE and f_antialiased >= _ANTIALIASED_SHARE  # False with NaN

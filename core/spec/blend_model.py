@@ -32,6 +32,15 @@ __all__ = ["BlendModel", "edge_strength", "fit_paper_model", "principal_directio
 _EM_ITERATIONS = 3
 _TINY = np.float32(1e-12)
 _FAINT = np.float32(1e-30)
+#: How much further from the mean a neighbour must be to replace the EM's start: quantised
+#: images hold exact ties (two neighbours 819 / (81 * 255^2) from the mean), and float
+#: rounding, which differs between NumPy and a GPU (fused multiply-adds, a reciprocal for a
+#: division), broke them differently: the unconverged direction, and with it the extremes,
+#: differed on 158 of 27 M samples of a 3000 x 3000 photo-like pair, by up to 37/255. Spreads
+#: equal within this share of the larger (or within SPREAD_TIE_FLOOR) keep the first.
+SPREAD_TIE = np.float32(1e-3)
+#: The same tie for spreads too small for a relative margin: rounding of the mean is absolute.
+SPREAD_TIE_FLOOR = np.float32(1e-6)
 
 
 @dataclass
@@ -109,12 +118,13 @@ def principal_direction(colours):
         total += colour
     mean = total / np.float32(9)
     deviations = [colour - mean for colour in colours]
-    # The first neighbour of largest spread (strictly larger replaces, as in the GL pass).
+    # The first neighbour of largest spread; a later one replaces it only when further by
+    # more than a tie (SPREAD_TIE), as in the GL pass.
     x = deviations[0].copy()
     farthest = dot(x, x)
     for y in deviations[1:]:
         spread = dot(y, y)
-        further = spread > farthest
+        further = spread > farthest + np.maximum(farthest * SPREAD_TIE, SPREAD_TIE_FLOOR)
         np.copyto(farthest, spread, where=further)
         np.copyto(x, y, where=further)
     scatter = {}

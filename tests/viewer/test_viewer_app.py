@@ -374,3 +374,26 @@ def test_strength_box_and_slider_override_the_safe_default(app, image_pair):
     click(app, centre(app.widget_rects["strength auto"]))
     assert app.recovery.settings.strength is None
     assert app.engine.last_plan.strength == chosen
+
+
+def test_every_slider_label_is_drawn_whole_inside_the_panel(app, image_pair, tmp_path):
+    """Issue 20 item 12: with its "auto" box unticked the strength slider took the full item
+    width after the box, and its label was cut at the panel's edge to "streng"."""
+    from imgui_bundle import imgui
+
+    import aarecovery
+    from aarecovery.viewer.sources import PairSource
+
+    assert app.opener.open(PairSource(*image_pair))
+    frames(app, 3)
+    click(app, centre(app.widget_rects["strength auto"]))
+    frames(app, 2)
+    app.step(capture=True)
+    aarecovery.write_image(tmp_path / "panel.png", app.last_screenshot[:, :int(app.panel_width)])
+    style = imgui.get_style()
+    for key in aarecovery.PARAMETERS:
+        left, top, right, bottom = (int(round(v)) for v in app.widget_rects[f"{key} label"])
+        assert right <= app.panel_width - style.window_padding.x / 2, (key, right, app.panel_width)
+        text = app.last_screenshot[top:bottom, left:right].min(axis=-1) > 200
+        drawn = np.nonzero(text.any(axis=0))[0]
+        assert drawn.size and drawn[-1] >= right - left - 3, (key, drawn[-1:], right - left)

@@ -1,5 +1,7 @@
 """Making a standalone OpenGL 3.3 context, or saying clearly why there is none."""
 
+import os
+
 import moderngl
 
 from ...errors import InputError
@@ -18,7 +20,7 @@ class GLUnavailable(InputError, RuntimeError):
 
     def __init__(self, reason):
         super().__init__(f"no OpenGL 3.3 context here ({reason}); use the NumPy backend (--backend numpy, "
-                         "backend='numpy': the same result, slower), or install an OpenGL 3.3 driver "
+                         "backend='numpy': the same result up to float rounding, slower), or install an OpenGL 3.3 driver "
                          "(Debian and Ubuntu: apt-get install libegl1 libgl1-mesa-dri)")
         self.reason = reason
 
@@ -38,6 +40,10 @@ def create_context():
     GLUnavailable
         With every attempt's reason in the message.
     """
+    # Mesa's EGL prints its warnings (a driver it could not load, a screen it could not
+    # make) straight to stderr, beside our one-line messages; the reasons that matter come
+    # back in the exception. A level the user set is kept.
+    os.environ.setdefault("EGL_LOG_LEVEL", "fatal")
     reasons = []
     for options in ({"backend": "egl"}, {}):
         try:

@@ -9,6 +9,8 @@ uniform float strength;  // the safe default's per-image repair strength; 1 for 
 
 const float TINY = 1e-12;
 const float FAINT = 1e-30;
+const float SPREAD_TIE = 1e-3;        // a start further by less is a tie: the first wins
+const float SPREAD_TIE_FLOOR = 1e-6;
 
 struct BlendFit {
     vec4 model;           // alpha, beta, the extremes' offsets (+ 81, 162: pure colours), residual
@@ -25,13 +27,13 @@ vec4 principal_direction(vec4 c[9]) {
     for (int i = 0; i < 9; ++i) mean += c[i];
     mean /= 9.0;
     vec4 x = vec4(0.0);
-    float farthest = -1.0;
+    float farthest = -1.0;  // the centre (i = 0) always starts
     float s00 = 0.0, s01 = 0.0, s02 = 0.0, s03 = 0.0, s11 = 0.0, s12 = 0.0, s13 = 0.0;
     float s22 = 0.0, s23 = 0.0, s33 = 0.0;
     for (int i = 0; i < 9; ++i) {
         vec4 y = c[i] - mean;
         float spread = dot(y, y);
-        if (spread > farthest) { farthest = spread; x = y; }
+        if (spread > farthest + max(farthest * SPREAD_TIE, SPREAD_TIE_FLOOR)) { farthest = spread; x = y; }
         s00 += y.x * y.x; s01 += y.x * y.y; s02 += y.x * y.z; s03 += y.x * y.w;
         s11 += y.y * y.y; s12 += y.y * y.z; s13 += y.y * y.w;
         s22 += y.z * y.z; s23 += y.z * y.w; s33 += y.w * y.w;
