@@ -30,7 +30,7 @@ class RecoverySummary:
     Attributes
     ----------
     plan : Plan
-        Mode, blend space, strength, pure colours, and the reason.
+        Mode, blend space, strength, pure colours, the decision's name and the reason.
     changed_pixels : int or None
         Pixels of the whole image where R differs from F by more than half an 8-bit step
         (None when not counted: a pair streamed from file to file is never whole in memory).
@@ -44,16 +44,22 @@ class RecoverySummary:
     changed_pixels: int
     edge_share: float
 
+    @property
+    def decision(self):
+        """Decision: which exit of the plan was taken (``plan.decision``)."""
+        return self.plan.decision
+
     def line(self, force="strength=1"):
         """The one line; `force` names the way to ask for a repair (``--strength 1`` on
         the command line, the dialog's control in the plug-in)."""
         plan = self.plan
         if plan.keeps_filtered:
-            return f"returned F unchanged ({plan.mode} mode): {plan.reason}; to repair anyway, use {force}"
+            return (f"returned F unchanged ({plan.mode} mode, {plan.decision}): {plan.reason}; "
+                    f"to repair anyway, use {force}")
         pure = ", pure colours of thin features" if plan.pure_colours is not None else ""
         what = ("repaired the edges" if self.edge_share is None else
                 f"repaired {self.edge_share:.0%} of the edge pixels ({self.changed_pixels} pixels changed)")
-        return f"{what} in {plan.mode} mode: strength {plan.strength:g}, blend in {plan.blend_space}{pure}"
+        return f"{what} in {plan.mode} mode ({plan.decision}): strength {plan.strength:g}, blend in {plan.blend_space}{pure}"
 
 
 def _changed(filtered, recovered):

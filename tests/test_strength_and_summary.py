@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import aarecovery
+from aarecovery import Decision
 from aarecovery.cli import main
 from scenes import disc_and_bar
 from test_cli_recover import edge_pair
@@ -65,7 +66,7 @@ def test_summary_counts_the_changed_pixels_and_names_the_plan(threshold_pair, ba
     assert 0.2 < summary.edge_share <= 1
     plan = summary.plan
     assert summary.line() == (f"repaired {summary.edge_share:.0%} of the edge pixels ({changed} pixels changed) in "
-                              f"safe mode: strength {plan.strength:g}, blend in {plan.blend_space}"
+                              f"safe mode ({plan.decision}): strength {plan.strength:g}, blend in {plan.blend_space}"
                               + (", pure colours of thin features" if plan.pure_colours is not None else ""))
 
 
@@ -77,7 +78,8 @@ def test_summary_of_a_kept_f_says_why_and_how_to_force(blur_pair):
         summary = aarecovery.summarize_recovery(engine.last_plan, original, filtered, recovered)
     assert summary.changed_pixels == 0
     line = summary.line(force="--strength 1")
-    assert line.startswith("returned F unchanged (safe mode): F is a low-pass (blur) of O")
+    assert summary.decision == Decision.LOWPASS_KEPT
+    assert line.startswith("returned F unchanged (safe mode, lowpass-kept): F is a low-pass (blur) of O")
     assert line.endswith("; to repair anyway, use --strength 1")
 
 

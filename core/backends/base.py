@@ -5,12 +5,49 @@ import runs back up: the plan layer makes a :class:`Plan`, the engine hands it t
 :class:`Backend`, and the backend returns pixels and :class:`RecoveryMaps`.
 """
 
+import enum
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
-__all__ = ["Plan", "RecoveryMaps", "Capabilities", "Backend", "ReadyResult"]
+__all__ = ["Decision", "Plan", "RecoveryMaps", "Capabilities", "Backend", "ReadyResult"]
+
+
+class Decision(str, enum.Enum):
+    """Which of the plan's exits was taken: its name, for tests, reports and messages.
+
+    The safe default's exits are listed in the order ``aarecovery.plan.analysis.analyse``
+    takes them; the value is the name reports print. A ``str`` enum, so that a report's
+    column and a comparison with the name as text both work.
+    """
+
+    PAPER = "paper"
+    """``mode="paper"``: the published method, no analysis."""
+    LOWPASS_KEPT = "lowpass-kept"
+    """F is a blur of O: its soft edges are the filter's intent, F is kept."""
+    AFFINE_KEPT = "affine-kept"
+    """F is an affine map of O on its edges: the edges are already right, F is kept."""
+    POINTWISE_HARD_EDGED = "pointwise-hard-edged"
+    """A point-wise filter on hard-edged content: full strength (and pure colours of thin
+    features when the table allows)."""
+    POINTWISE_CALIBRATED = "pointwise-calibrated"
+    """A point-wise filter on a textured image: the strength self-calibration finds."""
+    NEIGHBOURHOOD_TEXTURED_KEPT = "neighbourhood-textured-kept"
+    """A filter that is neither point-wise nor a colour map, on a textured image: F is kept."""
+    COLOUR_MAP_KEPT = "colour-map-kept"
+    """A colour map on a textured image whose repairs would be no larger than the model's
+    own error: F is kept."""
+    COLOUR_MAP_CALIBRATED = "colour-map-calibrated"
+    """A colour map (a palette quantiser) on a textured image: the calibrated strength."""
+    NEIGHBOURHOOD_HARD_EDGED_KEPT = "neighbourhood-hard-edged-kept"
+    """A neighbourhood filter on hard-edged content whose repairs would be no larger than the
+    model's own error: F is kept."""
+    NEIGHBOURHOOD_HARD_EDGED = "neighbourhood-hard-edged"
+    """A neighbourhood filter on hard-edged content: the paper's passes at full strength."""
+
+    def __str__(self):
+        return self.value
 
 
 @dataclass(frozen=True)
@@ -35,6 +72,8 @@ class Plan:
     mode : {"safe", "paper"}
     reason : str
         One line saying why, for messages and the evaluation report.
+    decision : Decision
+        Which exit of the plan was taken, by name.
     """
 
     sigma_d: float
@@ -45,6 +84,7 @@ class Plan:
     pure_colours: object = None
     mode: str = "paper"
     reason: str = "the published method"
+    decision: Decision = Decision.PAPER
 
     @property
     def keeps_filtered(self):
