@@ -32,7 +32,9 @@ class Decision(str, enum.Enum):
     """A point-wise filter on hard-edged content: full strength (and pure colours of thin
     features when the table allows)."""
     POINTWISE_CALIBRATED = "pointwise-calibrated"
-    """A point-wise filter on a textured image: the strength self-calibration finds."""
+    """A point-wise filter on a textured image: the strength self-calibration finds, in the
+    regions that read as textured; full strength in those that read as hard-edged (text or
+    drawings over the photo: the local plan, ``aarecovery.spec.local_plan``)."""
     NEIGHBOURHOOD_TEXTURED_KEPT = "neighbourhood-textured-kept"
     """A filter that is neither point-wise nor a colour map, on a textured image: F is kept."""
     COLOUR_MAP_KEPT = "colour-map-kept"
@@ -74,6 +76,12 @@ class Plan:
         One line saying why, for messages and the evaluation report.
     decision : Decision
         Which exit of the plan was taken, by name.
+    local : LocalStrength or None
+        The local plan (``aarecovery.spec.local_plan``): a per-pixel factor of ``beta``, read
+        from O, on top of `strength`; None: `strength` alone, everywhere.
+    forcing : Forcing or None
+        Where the safe default keeps F: whether forcing a repair may help, and why or what
+        it risks (``aarecovery.plan.forcing``).
     """
 
     sigma_d: float
@@ -85,11 +93,19 @@ class Plan:
     mode: str = "paper"
     reason: str = "the published method"
     decision: Decision = Decision.PAPER
+    local: object = None
+    forcing: object = None
 
     @property
     def keeps_filtered(self):
         """bool: the plan returns F unchanged (strength 0)."""
         return self.strength == 0
+
+    @property
+    def reach(self):
+        """int: how far beyond the model's own neighbourhood the plan reads O (the local
+        plan's factor; 0 without one): a tile's extra halo."""
+        return 0 if self.local is None else self.local.reach
 
 
 @dataclass
@@ -106,14 +122,18 @@ class RecoveryMaps:
         Product of the Sobel magnitudes of O and F.
     residual : ndarray of float32, shape (H, W)
         Distance of O's colour from its two-colour blend.
+    strength : ndarray of float32, shape (H, W)
+        The plan's strength at each pixel, which multiplies the confidence: the local plan's
+        map, or the one strength everywhere.
     """
 
     alpha: np.ndarray
     beta: np.ndarray
     edge_strength: np.ndarray
     residual: np.ndarray
+    strength: np.ndarray
 
-    NAMES = ("alpha", "beta", "edge_strength", "residual")
+    NAMES = ("alpha", "beta", "edge_strength", "residual", "strength")
 
 
 @dataclass(frozen=True)

@@ -49,9 +49,10 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
                            + ("" if asked is None else f"; strength {asked:g} as asked"), decision=Decision.PAPER)
     if analysis is None:
         analysis = analyse_pair(original, filtered, linear)
-    # A strength the user gives overrides the analysis's, and forces a repair where it keeps
-    # F; the other decisions (blend space, pure colours) stand.
+    # A strength the user gives overrides the analysis's, and its local plan, and forces a
+    # repair where it keeps F; the other decisions (blend space, pure colours) stand.
     return Plan(**common, blend_space=blend_space or analysis.blend_space,
                 strength=analysis.strength if asked is None else asked, pure_colours=analysis.pure_colours,
-                mode="safe", decision=analysis.decision, reason=analysis.reason + ("" if asked is None else
-                                                       f"; strength {asked:g} as asked instead"))
+                mode="safe", decision=analysis.decision, local=analysis.local if asked is None else None,
+                forcing=analysis.forcing,
+                reason=analysis.reason + ("" if asked is None else f"; strength {asked:g} as asked instead"))

@@ -42,6 +42,8 @@ from collections import namedtuple
 import moderngl
 import numpy as np
 
+from ...contract import to_rgba_float
+from ...spec.local_plan import encoded_colour, strength_map
 from ...spec.pure_colours import PALETTE_SIZE
 from ...tiling import DEFAULT_TILES
 from ..base import Capabilities, ReadyResult, RecoveryMaps
@@ -58,9 +60,10 @@ EngineTexture = namedtuple("EngineTexture", "texture channel linear")
 _CONVERT_NONE, _CONVERT_DECODE, _CONVERT_ENCODE = 0, 1, 2
 # Where each map lives: (texture key, channel).
 _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("model", 3),
-                 "edge_strength": ("edge", 0)}
+                 "edge_strength": ("edge", 0), "strength": ("strength", 0)}
 # The textures made when first needed: (components, dtype); "result" has F's.
 _WORK_TEXTURES = {"original_work": (4, "f4"), "filtered_work": (4, "f4"), "model": (4, "f4"), "edge": (1, "f4"),
+                  "strength_factor": (1, "f4"), "strength": (1, "f4"),
                   "fixed_a": (4, "f4"), "fixed_b": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4")}
 _RESULT_BITS = {np.dtype(np.uint8): 8, np.dtype(np.uint16): 16}
 
@@ -168,6 +171,7 @@ class GLBackend:
         # software renderer would only add a copy (llvmpipe computes on the CPU anyway).
         self._overlap_readback = not software_renderer(self.context)
         self._ran = None
+        self._original_source = self._factor = None
 
     # -- images -----------------------------------------------------------------------------
     @_current
@@ -180,6 +184,10 @@ class GLBackend:
             self._key = key
         self._upload("original", original, o_layout, o_dtype)
         self._upload("filtered", filtered, f_layout, f_dtype)
+        # The local plan's factor is computed from O by its NumPy specification when a plan
+        # asks for it, and uploaded: both backends apply the same numbers.
+        self._original_source = (original, o_layout, linear_input)
+        self._factor = None
         self._stage("upload")
         self._classified = set()
         self._working_lists = set()
@@ -341,7 +349,12 @@ class GLBackend:
         if prior is not None:
             sources["transfer_table"] = self._transfer_table(prior)
             uniforms.update(self._pure_colour_uniforms(prior))
-        defines = {**self._defines, "PURE_COLOURS": int(prior is not None)}
+        factor = self._local_factor(plan.local)
+        if factor is not None:
+            sources["strength_factor"] = self._work("strength_factor")
+        if maps:
+            self._work("strength").write(strength_map(plan, factor, self._key[0][::-1]))
+        defines = {**self._defines, "PURE_COLOURS": int(prior is not None), "LOCAL_STRENGTH": int(factor is not None)}
         with self._passes():
             if active not in self._working_lists:
                 self._to_working_space(lists, "dilated")
@@ -364,6 +377,17 @@ class GLBackend:
                 self._jacobi_steps(sources, defines, lists, plan.iterations)
         self._stage("passes")
         self._ran = {"maps": maps}
+
+    def _local_factor(self, local):
+        """The local plan's factor for the loaded O (computed once per pair and plan), uploaded."""
+        if local is None:
+            return None
+        if self._factor is None or self._factor[0] != local:
+            original, o_layout, linear_input = self._original_source
+            factor = local.factor(encoded_colour(to_rgba_float(original, o_layout, "original"), linear_input))
+            self._work("strength_factor").write(np.ascontiguousarray(factor))
+            self._factor = (local, factor)
+        return self._factor[1]
 
     def _transfer_table(self, prior):
         """The filter's table (3 KB): per run, as it belongs to the plan, not to the loaded pair."""
@@ -461,8 +485,10 @@ class GLBackend:
         self._textures["model"].read_into(model)
         edge = np.empty((height, width), np.float32)
         self._textures["edge"].read_into(edge)
+        strength = np.empty((height, width), np.float32)
+        self._textures["strength"].read_into(strength)
         return RecoveryMaps(np.ascontiguousarray(model[..., 0]), np.ascontiguousarray(model[..., 1]), edge,
-                            np.ascontiguousarray(model[..., 3]))
+                            np.ascontiguousarray(model[..., 3]), strength)
 
     def texture(self, name):
         if name in ("result", "original", "filtered"):
