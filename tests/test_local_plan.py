@@ -1,6 +1,8 @@
 """The local plan: full strength where text and drawings lie over a photo, the calibrated
 strength on the photo, smooth between, the same tiled and untiled and on both backends."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -58,7 +60,7 @@ def test_the_repair_is_better_on_the_text_and_the_same_on_the_photo(banner_over_
         plan = engine.plan()
         engine.run(plan)
         local = engine.result()
-        engine.run(plan.__class__(**{**plan.__dict__, "local": None, "strength": plan.local.textured}))
+        engine.run(dataclasses.replace(plan, local=None, strength=plan.local.textured))
         one_strength = engine.result()
     band = edge_band(case.original, case.filtered, case.reference)
     text, photo = band.copy(), band.copy()

@@ -94,10 +94,15 @@ def _grow(mask, radius):
     return out
 
 
-def build_mixed_cases(half, space="linear"):
-    """Every mixed case of `half` ("tune" or "heldout"): list of :class:`MixedCase`."""
+def build_mixed_cases(half, space="linear", *, photos=None, filters=None):
+    """The mixed cases of `half` ("tune" or "heldout"): list of :class:`MixedCase`.
+
+    `photos` and `filters` choose among the half's (default: all of them).
+    """
     from .tools import TOOLS
-    photos, filters = MIXED_SPLIT[half]
+    all_photos, all_filters = MIXED_SPLIT[half]
+    photos = tuple(p for p in all_photos if photos is None or p in photos)
+    filters = tuple(f for f in all_filters if filters is None or f in filters)
     scenes = {photo: mixed_scene(photo, seed) for seed, photo in enumerate(photos)}
     originals = {photo: np.rint(box_downsample(scene, _K, space) * 255).astype(np.float32) / 255
                  for photo, (scene, _) in scenes.items()}
