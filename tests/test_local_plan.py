@@ -8,6 +8,7 @@ import pytest
 
 import aarecovery
 from aarecovery import Decision
+from aarecovery.colour import srgb_to_linear
 from aarecovery.lab import scenes as _scenes
 from aarecovery.lab.groundtruth import make_case
 from aarecovery.spec.local_plan import LocalStrength, flat_share, hard_edged_weight
@@ -81,20 +82,41 @@ def test_tiled_equals_untiled_with_the_local_plan(banner_over_photo):
                                                          tile_size=tile), whole)
 
 
-@pytest.mark.gl
+# The GLSL twin (local_plan.glsl) against the specification: the counts are exact in both,
+# the share, smoothstep and factor are float32 arithmetic in a different order.
+_FACTOR_TOLERANCE = 1e-6
+
+
+def _pairs(case):
+    to8 = lambda image: np.rint(image * 255).astype(np.uint8)
+    yield "float", case.original, case.filtered, False
+    yield "uint8", to8(case.original), to8(case.filtered), False
+    yield "linear", srgb_to_linear(case.original), srgb_to_linear(case.filtered), True
+
+
 @pytest.mark.filterwarnings("ignore::aarecovery.errors.TileSizeWarning")
-def test_gl_applies_the_same_strength_map_as_numpy(banner_over_photo):
-    case = banner_over_photo
-    results = {}
-    for backend in ("numpy", "gl"):
-        results[backend] = aarecovery.recover(case.original, case.filtered, backend=backend, return_maps=True)
-    (numpy_result, numpy_maps), (gl_result, gl_maps) = results["numpy"], results["gl"]
-    np.testing.assert_array_equal(gl_maps.strength, numpy_maps.strength)
-    np.testing.assert_allclose(gl_maps.beta, numpy_maps.beta, atol=1e-5)
-    np.testing.assert_allclose(gl_result, numpy_result, atol=1e-5)
-    tiled, tiled_maps = aarecovery.recover(case.original, case.filtered, backend="gl", tile_size=40, return_maps=True)
-    np.testing.assert_allclose(tiled, gl_result, atol=1e-6)
-    np.testing.assert_array_equal(tiled_maps.strength, numpy_maps.strength)
+def test_gl_computes_the_same_strength_map_as_numpy(banner_over_photo, gl_path):
+    for name, original, filtered, linear in _pairs(banner_over_photo):
+        with aarecovery.Engine("numpy") as engine:
+            engine.set_images(original, filtered, linear=linear)
+            plan = engine.plan()
+        assert plan.local is not None, name
+        results = {}
+        for backend in ("numpy", "gl"):
+            with aarecovery.Engine(backend, gl_path=gl_path if backend == "gl" else "auto") as engine:
+                results[backend] = aarecovery.recover(original, filtered, engine=engine, linear=linear,
+                                                      return_maps=True)
+        (numpy_result, numpy_maps), (gl_result, gl_maps) = results["numpy"], results["gl"]
+        np.testing.assert_allclose(gl_maps.strength, numpy_maps.strength, atol=_FACTOR_TOLERANCE, err_msg=name)
+        assert np.abs(numpy_maps.strength - plan.local.textured).max() > 0.3, name
+        np.testing.assert_allclose(gl_maps.beta, numpy_maps.beta, atol=1e-5, err_msg=name)
+        # The stated tolerances of the parity tests: one 8-bit level, 1e-5 on float.
+        np.testing.assert_allclose(gl_result.astype(np.float64), numpy_result, atol=1 if name == "uint8" else 1e-5,
+                                   err_msg=name)
+        tiled, tiled_maps = aarecovery.recover(original, filtered, backend="gl", gl_path=gl_path, linear=linear,
+                                               tile_size=40, return_maps=True)
+        np.testing.assert_array_equal(tiled, gl_result, err_msg=name)
+        np.testing.assert_allclose(tiled_maps.strength, gl_maps.strength, atol=_FACTOR_TOLERANCE, err_msg=name)
 
 
 def test_the_summary_says_how_the_image_divided(banner_over_photo):

@@ -13,7 +13,8 @@ around them (a tenth of them 0.35-0.39), the photos' edge pixels 0.00-0.02 (99th
 whole-image decision reads it.
 
 Per pixel, in passes that read only :data:`REACH` pixels around it, so that a tile with that
-much more halo gives the untiled result:
+much more halo gives the untiled result (the GL twin, ``backends/gl/shaders/local_plan.glsl``,
+runs the same passes on each tile: 1, 2 and the sums of 3 along rows, then along columns):
 
 1. :func:`flat_pixels`: where O's 3 x 3 neighbourhood spans at most half an 8-bit level
    in every channel and is not black.

@@ -42,8 +42,7 @@ from collections import namedtuple
 import moderngl
 import numpy as np
 
-from ...contract import to_rgba_float
-from ...spec.local_plan import encoded_colour, strength_map
+from ...spec.local_plan import strength_map
 from ...spec.pure_colours import PALETTE_SIZE
 from ...tiling import DEFAULT_TILES
 from ..base import Capabilities, ReadyResult, RecoveryMaps
@@ -63,7 +62,7 @@ _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("mode
                  "edge_strength": ("edge", 0), "strength": ("strength", 0)}
 # The textures made when first needed: (components, dtype); "result" has F's.
 _WORK_TEXTURES = {"original_work": (4, "f4"), "filtered_work": (4, "f4"), "model": (4, "f4"), "edge": (1, "f4"),
-                  "strength_factor": (1, "f4"), "strength": (1, "f4"),
+                  "local_flat": (1, "f4"), "local_rows": (1, "f4"), "strength_factor": (1, "f4"), "strength": (1, "f4"),
                   "fixed_a": (4, "f4"), "fixed_b": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4")}
 _RESULT_BITS = {np.dtype(np.uint8): 8, np.dtype(np.uint16): 16}
 
@@ -171,7 +170,7 @@ class GLBackend:
         # software renderer would only add a copy (llvmpipe computes on the CPU anyway).
         self._overlap_readback = not software_renderer(self.context)
         self._ran = None
-        self._original_source = self._factor = None
+        self._factor_for = None
 
     # -- images -----------------------------------------------------------------------------
     @_current
@@ -184,10 +183,7 @@ class GLBackend:
             self._key = key
         self._upload("original", original, o_layout, o_dtype)
         self._upload("filtered", filtered, f_layout, f_dtype)
-        # The local plan's factor is computed from O by its NumPy specification when a plan
-        # asks for it, and uploaded: both backends apply the same numbers.
-        self._original_source = (original, o_layout, linear_input)
-        self._factor = None
+        self._factor_for = None
         self._stage("upload")
         self._classified = set()
         self._working_lists = set()
@@ -349,13 +345,15 @@ class GLBackend:
         if prior is not None:
             sources["transfer_table"] = self._transfer_table(prior)
             uniforms.update(self._pure_colour_uniforms(prior))
-        factor = self._local_factor(plan.local)
-        if factor is not None:
+        local = plan.local is not None
+        if local:
             sources["strength_factor"] = self._work("strength_factor")
-        if maps:
-            self._work("strength").write(strength_map(plan, factor, self._key[0][::-1]))
-        defines = {**self._defines, "PURE_COLOURS": int(prior is not None), "LOCAL_STRENGTH": int(factor is not None)}
+        defines = {**self._defines, "PURE_COLOURS": int(prior is not None), "LOCAL_STRENGTH": int(local)}
         with self._passes():
+            if local:
+                self._local_factor(plan.local)
+            if maps:
+                self._strength_map(plan)
             if active not in self._working_lists:
                 self._to_working_space(lists, "dilated")
                 self._working_lists.add(active)
@@ -379,15 +377,25 @@ class GLBackend:
         self._ran = {"maps": maps}
 
     def _local_factor(self, local):
-        """The local plan's factor for the loaded O (computed once per pair and plan), uploaded."""
-        if local is None:
-            return None
-        if self._factor is None or self._factor[0] != local:
-            original, o_layout, linear_input = self._original_source
-            factor = local.factor(encoded_colour(to_rgba_float(original, o_layout, "original"), linear_input))
-            self._work("strength_factor").write(np.ascontiguousarray(factor))
-            self._factor = (local, factor)
-        return self._factor[1]
+        """The local plan's factor of beta for the loaded O, once per pair and plan (three passes)."""
+        if self._factor_for == local:
+            return
+        defines = {"LOCAL_ENCODE": int(self._linear["original"])}
+        steps = (({"original_image": self._textures["original"]}, "local_flat"),
+                 ({"local_input": self._work("local_flat")}, "local_rows"),
+                 ({"local_input": self._work("local_rows")}, "strength_factor"))
+        for number, (inputs, output) in enumerate(steps, 1):
+            self._path.run_pass("local_plan", inputs, [self._work(output)], uniforms={"textured": local.textured},
+                                defines={**defines, "LOCAL_PASS": number})
+        self._factor_for = local
+
+    def _strength_map(self, plan):
+        """The strength map of the maps: the plan's strength times the local factor (read back)."""
+        factor = None
+        if plan.local is not None:
+            factor = np.empty(self._key[0][::-1], np.float32)
+            self._work("strength_factor").read_into(factor)
+        self._work("strength").write(strength_map(plan, factor, self._key[0][::-1]))
 
     def _transfer_table(self, prior):
         """The filter's table (3 KB): per run, as it belongs to the plan, not to the loaded pair."""
