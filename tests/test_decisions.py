@@ -73,4 +73,6 @@ def test_the_plan_names_the_decision_it_took(decision):
         paper = engine.plan(mode="paper")
     assert plan.decision == decision, plan.reason
     assert plan.keeps_filtered == (decision in _KEEPS_F)
+    # Where F is kept, the plan says what forcing a repair would do (the summary's hint).
+    assert (plan.forcing is not None) == plan.keeps_filtered
     assert paper.decision == Decision.PAPER

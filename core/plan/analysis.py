@@ -98,10 +98,6 @@ class PairAnalysis:
     local: object = None
     forcing: object = None
 
-    def __post_init__(self):
-        if self.strength == 0 and self.forcing is None:
-            object.__setattr__(self, "forcing", forcing_advice(self.decision))
-
 
 def analysis_crop(image):
     """The central crop of at most 512 x 512 pixels that the analysis reads."""
@@ -151,12 +147,13 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     lowpass, kernel_residual, _ = fit_lowpass(o, f)
     if lowpass:
         return PairAnalysis(space, 0.0, f"F is a low-pass (blur) of O (kernel residual {kernel_residual:.3f}): kept F",
-                            Decision.LOWPASS_KEPT)
+                            Decision.LOWPASS_KEPT, forcing=forcing_advice(Decision.LOWPASS_KEPT))
     edges = gradient_magnitude(o) >= EDGE_GRADIENT
     affine = affine_share(o, f, edges, space)
     if affine >= AFFINE_SHARE:
         return PairAnalysis(space, 0.0, f"F is an affine map of O in {space} values on {affine:.3f} of the edges, "
-                                        "so its edges are already right: kept F", Decision.AFFINE_KEPT)
+                                        "so its edges are already right: kept F", Decision.AFFINE_KEPT,
+                            forcing=forcing_advice(Decision.AFFINE_KEPT))
     transfer = fit_pointwise(o, f, edges)
     textured, texture = is_textured(o, fit)
     if transfer.consistency >= POINTWISE_SHARE and not textured:
@@ -191,7 +188,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         if colour_map.consistency < COLOUR_MAP_SHARE:
             return PairAnalysis(space, _PHOTO_NEIGHBOURHOOD_STRENGTH,
                                 f"neighbourhood filter on a textured image ({texture}): "
-                                f"strength {_PHOTO_NEIGHBOURHOOD_STRENGTH:g}", Decision.NEIGHBOURHOOD_TEXTURED_KEPT)
+                                f"strength {_PHOTO_NEIGHBOURHOOD_STRENGTH:g}", Decision.NEIGHBOURHOOD_TEXTURED_KEPT,
+                                forcing=forcing_advice(Decision.NEIGHBOURHOOD_TEXTURED_KEPT))
         # A colour map that bends colours smoothly (a hue change) leaves repairs no larger
         # than the model's error; calibration alone chose 0.5 there and lost 0.73 dB (GEGL's
         # hue-chroma on maps, quick tuning half: ratio 1.18); the held-out quantised photos
