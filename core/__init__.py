@@ -15,7 +15,7 @@ in ``docs/architecture.md``.
 __version__ = "0.1.0"
 
 from . import filters
-from .backends.base import Plan, RecoveryMaps
+from .backends.base import Decision, Plan, RecoveryMaps
 from .backends import GLUnavailable
 from .batch import recover_many
 from .engine import Engine
@@ -26,6 +26,6 @@ from .params import BACKENDS, BLEND_SPACES, GL_PATHS, MODES, PARAMETERS
 from .pipeline import recover
 from .plan.order import check_order
 
-__all__ = ["recover", "recover_many", "check_order", "summarize_recovery", "Engine", "Plan", "RecoveryMaps",
+__all__ = ["recover", "recover_many", "check_order", "summarize_recovery", "Engine", "Plan", "Decision", "RecoveryMaps",
            "RecoverySummary", "InputError", "GLUnavailable", "OrderWarning", "read_image", "write_image", "filters",
            "PARAMETERS", "BACKENDS", "GL_PATHS", "MODES", "BLEND_SPACES", "__version__"]

@@ -258,7 +258,7 @@ class Engine:
 
         Parameters
         ----------
-        name : {"result", "original", "filtered", "alpha", "beta", "edge_strength", "residual"}
+        name : {"result", "original", "filtered", "alpha", "beta", "edge_strength", "residual", "strength"}
             Images are straight RGBA; maps exist after ``compute(maps=True)``.
 
         Returns

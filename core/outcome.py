@@ -13,6 +13,7 @@ import numpy as np
 from .contract import layout_of, to_rgba_float
 from .plan.calibration import EDGE_GRADIENT
 from .sample import analysis_window
+from .spec.local_plan import encoded_colour
 from .spec.sobel import gradient_magnitude
 
 __all__ = ["RecoverySummary", "summarize_recovery"]
@@ -30,7 +31,7 @@ class RecoverySummary:
     Attributes
     ----------
     plan : Plan
-        Mode, blend space, strength, pure colours, and the reason.
+        Mode, blend space, strength, pure colours, the decision's name and the reason.
     changed_pixels : int or None
         Pixels of the whole image where R differs from F by more than half an 8-bit step
         (None when not counted: a pair streamed from file to file is never whole in memory).
@@ -38,22 +39,50 @@ class RecoverySummary:
         The share of O's edge pixels (a Sobel / 8 of 0.02 or more) where R differs from F,
         measured on the window of at most 512 x 512 pixels that the safe default analyses
         (0 when it has no edge; None when not measured).
+    hard_edged_share : float or None
+        With a local plan: the share of those edge pixels that lie in regions read as
+        hard-edged (repaired at full strength); None without one.
     """
 
     plan: object
     changed_pixels: int
     edge_share: float
+    hard_edged_share: float = None
+
+    @property
+    def decision(self):
+        """Decision: which exit of the plan was taken (``plan.decision``)."""
+        return self.plan.decision
 
     def line(self, force="strength=1"):
         """The one line; `force` names the way to ask for a repair (``--strength 1`` on
         the command line, the dialog's control in the plug-in)."""
         plan = self.plan
         if plan.keeps_filtered:
-            return f"returned F unchanged ({plan.mode} mode): {plan.reason}; to repair anyway, use {force}"
+            return f"returned F unchanged ({plan.mode} mode, {plan.decision}): {plan.reason}; {_forcing(plan, force)}"
         pure = ", pure colours of thin features" if plan.pure_colours is not None else ""
         what = ("repaired the edges" if self.edge_share is None else
                 f"repaired {self.edge_share:.0%} of the edge pixels ({self.changed_pixels} pixels changed)")
-        return f"{what} in {plan.mode} mode: strength {plan.strength:g}, blend in {plan.blend_space}{pure}"
+        return f"{what} in {plan.mode} mode ({plan.decision}): {self._strength()}, blend in {plan.blend_space}{pure}"
+
+    def _strength(self):
+        plan = self.plan
+        if plan.local is None:
+            return f"strength {plan.strength:g}"
+        if self.hard_edged_share is None:
+            return f"strength {plan.strength:g} where hard-edged, {plan.strength * plan.local.textured:g} where textured"
+        return (f"text and drawings {self.hard_edged_share:.0%} of the edges at strength {plan.strength:g}, "
+                f"photo {1 - self.hard_edged_share:.0%} at {plan.strength * plan.local.textured:g}")
+
+
+def _forcing(plan, force):
+    """How to force a repair where the analysis found it may help, else what forcing risks."""
+    forcing = plan.forcing
+    if forcing is None:
+        return f"to repair anyway, use {force}"
+    if forcing.helps:
+        return f"a forced repair may help ({forcing.why}): use {force}"
+    return f"forcing a repair ({force}) risks {forcing.why}"
 
 
 def _changed(filtered, recovered):
@@ -65,7 +94,7 @@ def _changed(filtered, recovered):
     return difference > np.float32(_CHANGED * scale)
 
 
-def summarize_recovery(plan, original, filtered, recovered):
+def summarize_recovery(plan, original, filtered, recovered, linear=False):
     """Summarize a recovery of `original` and `filtered` into `recovered` under `plan`.
 
     Parameters
@@ -76,6 +105,8 @@ def summarize_recovery(plan, original, filtered, recovered):
     original, filtered, recovered : ndarray
         As given to and returned by :func:`aarecovery.recover`; `recovered` has the shape
         and dtype of `filtered`.
+    linear : bool
+        The images hold linear-light values (as given to ``recover``).
 
     Returns
     -------
@@ -86,7 +117,15 @@ def summarize_recovery(plan, original, filtered, recovered):
                   for top in range(0, f_layout.height, _STRIP_ROWS))
     window = analysis_window(lambda rows, cols: original[rows, cols], f_layout.height, f_layout.width)
     o_window = original[window]
-    edges = gradient_magnitude(to_rgba_float(o_window, layout_of(o_window, "original"), "original")[..., :3])
-    edges = edges >= EDGE_GRADIENT
+    o_rgba = to_rgba_float(o_window, layout_of(o_window, "original"), "original")
+    edges = gradient_magnitude(o_rgba[..., :3]) >= EDGE_GRADIENT
     share = float(_changed(filtered[window], recovered[window])[edges].mean()) if edges.any() else 0.0
-    return RecoverySummary(plan, changed, share)
+    return RecoverySummary(plan, changed, share, _hard_edged_share(plan, o_rgba, edges, linear))
+
+
+def _hard_edged_share(plan, o_rgba, edges, linear):
+    """The share of the window's edge pixels that the local plan repairs nearer full strength."""
+    if plan.local is None or not edges.any():
+        return None
+    factor = plan.local.factor(encoded_colour(o_rgba, linear))
+    return float((factor[edges] > (1 + plan.local.textured) / 2).mean())

@@ -160,9 +160,12 @@ def _recover_in_tiles(original, filtered, f_layout, plan, engine, tile, linear, 
     maps = None
     if return_maps:
         maps = RecoveryMaps(*(np.empty((height, width), np.float32) for _ in RecoveryMaps.NAMES))
+    # The local plan reads farther than the tile size was checked for: the tile grows by its
+    # reach on each side, so that its interior stays what the size was chosen for.
+    halo = halo_for(plan.iterations, plan.reach)
     pieces = recover_tiles(engine, lambda outer: (original[outer], filtered[outer]), plan,
-                           tiles(height, width, tile, halo_for(plan.iterations)), f_layout, linear=linear,
-                           maps=return_maps, into=result)
+                           tiles(height, width, min(engine.capabilities.max_tile, tile + 2 * plan.reach), halo),
+                           f_layout, linear=linear, maps=return_maps, into=result)
     for inner, _, tile_maps in pieces:
         if return_maps:
             for name in RecoveryMaps.NAMES:

@@ -95,10 +95,10 @@ def resolve_tile(capabilities, tile_size=None):
     return min(capabilities.max_tile, tile_size or min(capabilities.default_tile, STREAM_TILE))
 
 
-def stream_tile(tile, iterations):
+def stream_tile(tile, iterations, reach=0):
     """The inner side of a streamed tile: the largest multiple of 16 (TIFF's tile rule) that
-    fits in `tile` with its halo, and at least 16."""
-    return max(16, (tile - 2 * halo_for(iterations)) // 16 * 16)
+    fits in `tile` with its halo (``halo_for(iterations, reach)``), and at least 16."""
+    return max(16, (tile - 2 * halo_for(iterations, reach)) // 16 * 16)
 
 
 def open_pair(original_path, filtered_path, tile, iterations):
@@ -259,8 +259,8 @@ def recover_pair(pair, output, plan, *, engine, tile=None, linear=False):
         Largest tile side (:func:`resolve_tile`).
     linear : bool
     """
-    side = stream_tile(resolve_tile(engine.capabilities, tile), plan.iterations)
-    halo = halo_for(plan.iterations)
+    side = stream_tile(resolve_tile(engine.capabilities, tile), plan.iterations, plan.reach)
+    halo = halo_for(plan.iterations, plan.reach)
     grid = list(aligned_tiles(pair.height, pair.width, side, halo))
     if plan.keeps_filtered:
         pieces = ((inner, pair.filtered.read(*inner)) for inner, _ in grid)

@@ -31,8 +31,10 @@ DEFAULT_TILES = {"gl": 2048, "gl-software": 1024, "numpy": 512}
 SENSIBLE_TILE = 64
 
 
-def halo_for(iterations):
+def halo_for(iterations, reach=0):
     """Border width that makes a tiled result equal the untiled one.
+
+    `reach` is how much farther a plan reads O (``Plan.reach``: the local plan's factor).
 
     The model fit and Sobel read a 3x3 neighbourhood (radius 1), and each Jacobi iteration
     reads R at the extreme positions, again within radius 1 of the pixel. R after k
@@ -43,7 +45,7 @@ def halo_for(iterations):
     radius 2. Its image-border test only fires at a tile's edge, which lies beyond what the
     pixels a tile decides read.
     """
-    return max(iterations + 1, 2)
+    return max(iterations + 1, 2) + reach
 
 
 def smallest_tile(iterations):

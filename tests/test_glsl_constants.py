@@ -8,7 +8,7 @@ import pytest
 from aarecovery import colour
 from aarecovery.backends.gl import blocks
 from aarecovery.backends.gl.glsl import read_source
-from aarecovery.spec import blend_model, pure_colours
+from aarecovery.spec import blend_model, local_plan, pure_colours
 
 # (shader file, GLSL name) -> the value the NumPy specification uses.
 TWINS = {
@@ -20,6 +20,10 @@ TWINS = {
     ("pure_colours.glsl", "END_TOLERANCE"): pure_colours.END_TOLERANCE,
     ("pure_colours.glsl", "MIN_CONTRAST"): pure_colours.MIN_CONTRAST,
     ("pure_colours.glsl", "MIN_REACH"): pure_colours.MIN_REACH,
+    ("local_plan.glsl", "FLAT_SPAN"): local_plan.FLAT_SPAN,
+    ("local_plan.glsl", "REGION_RADIUS"): local_plan.REGION_RADIUS,
+    ("local_plan.glsl", "TEXTURED_SHARE"): local_plan.TEXTURED_SHARE,
+    ("local_plan.glsl", "HARD_EDGED_SHARE"): local_plan.HARD_EDGED_SHARE,
     ("blend_model.glsl", "TINY"): float(blend_model._TINY),
     ("blend_model.glsl", "FAINT"): float(blend_model._FAINT),
     ("blend_model.glsl", "SPREAD_TIE"): float(blend_model.SPREAD_TIE),

@@ -4,7 +4,9 @@ import numpy as np
 import pytest
 
 import aarecovery
+from aarecovery import Decision
 from aarecovery.cli import main
+from aarecovery.plan.forcing import forcing_advice
 from scenes import disc_and_bar
 from test_cli_recover import edge_pair
 
@@ -65,11 +67,11 @@ def test_summary_counts_the_changed_pixels_and_names_the_plan(threshold_pair, ba
     assert 0.2 < summary.edge_share <= 1
     plan = summary.plan
     assert summary.line() == (f"repaired {summary.edge_share:.0%} of the edge pixels ({changed} pixels changed) in "
-                              f"safe mode: strength {plan.strength:g}, blend in {plan.blend_space}"
+                              f"safe mode ({plan.decision}): strength {plan.strength:g}, blend in {plan.blend_space}"
                               + (", pure colours of thin features" if plan.pure_colours is not None else ""))
 
 
-def test_summary_of_a_kept_f_says_why_and_how_to_force(blur_pair):
+def test_summary_of_a_kept_f_says_why_and_what_forcing_risks(blur_pair):
     original, filtered = blur_pair
     with aarecovery.Engine("numpy") as engine:
         recovered = aarecovery.recover(original, filtered, engine=engine)
@@ -77,8 +79,10 @@ def test_summary_of_a_kept_f_says_why_and_how_to_force(blur_pair):
         summary = aarecovery.summarize_recovery(engine.last_plan, original, filtered, recovered)
     assert summary.changed_pixels == 0
     line = summary.line(force="--strength 1")
-    assert line.startswith("returned F unchanged (safe mode): F is a low-pass (blur) of O")
-    assert line.endswith("; to repair anyway, use --strength 1")
+    assert summary.decision == Decision.LOWPASS_KEPT
+    assert line.startswith("returned F unchanged (safe mode, lowpass-kept): F is a low-pass (blur) of O")
+    assert line.endswith("; forcing a repair (--strength 1) risks re-sharpening the soft edges the blur made on "
+                         "purpose")
 
 
 def test_summary_of_a_float_grey_pair_counts_in_its_own_scale():
@@ -100,7 +104,7 @@ def test_recover_prints_the_summary_and_takes_strength(tmp_path, capsys, blur_pa
                  "--backend", "numpy"]) == 0
     wrote, said = capsys.readouterr().out.splitlines()
     assert wrote.startswith(f"wrote {tmp_path / 'kept.png'}")
-    assert said.startswith("returned F unchanged") and said.endswith("use --strength 1")
+    assert said.startswith("returned F unchanged") and "forcing a repair (--strength 1) risks" in said
     assert main(["recover", str(tmp_path / "o.png"), str(tmp_path / "f.png"), "-o", str(tmp_path / "forced.png"),
                  "--backend", "numpy", "--strength", "1"]) == 0
     said = capsys.readouterr().out.splitlines()[1]
@@ -119,3 +123,37 @@ def test_filter_recover_prints_the_summary_and_strength_needs_recover(tmp_path, 
                  "--strength", "0.5"]) == 1
     assert "--strength only applies with --recover" in capsys.readouterr().err
     assert not (tmp_path / "t.png").exists()
+
+
+@pytest.mark.parametrize("errors, helps", [({0.0: 1.0, 0.25: 0.995, 0.5: 1.02, 1.0: 1.3, 0.125: 0.996}, True),
+                                           ({0.0: 1.0, 0.25: 1.1, 0.5: 1.3, 1.0: 1.6, 0.125: 1.04}, False)])
+def test_the_force_is_offered_only_where_the_calibration_saw_it_help(errors, helps):
+    forcing = forcing_advice(Decision.POINTWISE_CALIBRATED, errors=errors)
+    assert forcing.helps == helps
+    plan = aarecovery.Plan(0.1, 0.01, 3, strength=0.0, mode="safe", reason="calibration chose strength 0",
+                           decision=Decision.POINTWISE_CALIBRATED, forcing=forcing)
+    line = aarecovery.RecoverySummary(plan, 0, 0.0).line(force="--strength 1")
+    if helps:
+        assert line.endswith("a forced repair may help (at half resolution strength 0.25 was 0.5% closer than F, "
+                             "too little to choose it): use --strength 1")
+    else:
+        assert line.endswith("forcing a repair (--strength 1) risks a result farther from the truth than F: at half "
+                             "resolution every strength tried was worse than F (strength 1 by 60%)")
+
+
+def test_an_unsharp_masked_photo_is_not_offered_the_force():
+    """The issue's portrait: forced to full strength, its irises went grey with pale halos."""
+    from aarecovery.lab import scenes as _scenes
+    from aarecovery.lab.groundtruth import make_case
+    case = make_case(_scenes.render("astronaut", 64, 4), "unsharp", 4, "linear")
+    with aarecovery.Engine("numpy") as engine:
+        recovered = aarecovery.recover(case.original, case.filtered, engine=engine)
+        summary = aarecovery.summarize_recovery(engine.last_plan, case.original, case.filtered, recovered)
+    assert summary.decision == Decision.NEIGHBOURHOOD_TEXTURED_KEPT
+    assert "use --strength 1" not in summary.line(force="--strength 1")
+    assert "risks flattening the photo's texture" in summary.line(force="--strength 1")
+
+
+def test_a_repair_within_the_models_error_says_so():
+    forcing = forcing_advice(Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT, ratio=1.19)
+    assert not forcing.helps and "repair-to-error ratio 1.19" in forcing.why

@@ -12,7 +12,7 @@ from .image_view import Layer
 __all__ = ["Comparison", "MAP_VIEWS"]
 
 #: Views that show an intermediate map, which the recovery must keep.
-MAP_VIEWS = ("alpha", "beta", "edge_strength", "residual")
+MAP_VIEWS = ("alpha", "beta", "edge_strength", "residual", "strength")
 _IMAGE_NAMES = {"filtered": "F", "original": "O"}
 
 
@@ -104,5 +104,5 @@ class Comparison:
         if mode == "difference":
             return Layer.difference(result, texture("filtered"), self.difference_gain), None
         gain = {"alpha": 1.0, "beta": 1.0, "edge_strength": 1.0 / (3.0 * settings.sigma_e),
-                "residual": 1.0 / settings.sigma_d}[mode]
+                "residual": 1.0 / settings.sigma_d, "strength": 1.0}[mode]
         return Layer.map(texture(mode), gain), None

@@ -13,11 +13,12 @@ VIEW_MODES = (
     ("beta", "beta map (confidence)", "7"),
     ("edge_strength", "edge strength / (3 sigma_e)", "8"),
     ("residual", "residual / sigma_d", "9"),
+    ("strength", "strength map (the safe default's, per region)", "0"),
 )
 
 #: ``(keys, action)`` rows of the help overlay.
 KEY_HELP = (
-    ("1 ... 9", "views: R, F, O, split, |R - F|, alpha, beta, edge strength, residual"),
+    ("1 ... 9, 0", "views: R, F, O, split, |R - F|, alpha, beta, edge strength, residual, strength"),
     ("S", "split view on/off"),
     ("Space", "flicker: swap R and F (or O; C picks) in place"),
     ("K", "automatic flicker on/off"),

@@ -35,9 +35,12 @@ def _finding(engine, summary):
 
 
 def _strength(engine, summary):
-    strength = engine.last_plan.strength
+    plan = engine.last_plan
+    strength = plan.strength
     if strength == 0:
         return "F shown unchanged"
+    if plan.local is not None:
+        return f"strength {strength:.2g} on text and drawings, {strength * plan.local.textured:.2g} on photo"
     return "full strength" if strength == 1 else f"strength {strength:.2g}"
 
 
@@ -50,9 +53,11 @@ def _blend_space(engine, summary):
 
 def _how_to_force(engine, summary):
     plan = engine.last_plan
-    if plan.strength == 0:
+    if plan.strength != 0:
+        return None
+    if plan.forcing is None or plan.forcing.helps:
         return "untick auto strength to force a repair"
-    return None
+    return f"forcing a repair risks {plan.forcing.why}"
 
 
 def _repaired_share(engine, summary):

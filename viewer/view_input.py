@@ -104,9 +104,8 @@ class ViewInput:
                 app.saving.copy_command_line()
             return
         comparison, view = app.comparison, app.view
-        for index, (mode, _, _) in enumerate(VIEW_MODES):
-            if pressed(getattr(imgui.Key, f"_{index + 1}"), False) or pressed(
-                    getattr(imgui.Key, f"keypad{index + 1}"), False):
+        for mode, _, key in VIEW_MODES:
+            if pressed(getattr(imgui.Key, f"_{key}"), False) or pressed(getattr(imgui.Key, f"keypad{key}"), False):
                 comparison.set_view_mode(mode)
         if pressed(imgui.Key.s, False):
             comparison.toggle_split()

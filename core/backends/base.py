@@ -5,12 +5,51 @@ import runs back up: the plan layer makes a :class:`Plan`, the engine hands it t
 :class:`Backend`, and the backend returns pixels and :class:`RecoveryMaps`.
 """
 
+import enum
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
-__all__ = ["Plan", "RecoveryMaps", "Capabilities", "Backend", "ReadyResult"]
+__all__ = ["Decision", "Plan", "RecoveryMaps", "Capabilities", "Backend", "ReadyResult"]
+
+
+class Decision(str, enum.Enum):
+    """Which of the plan's exits was taken: its name, for tests, reports and messages.
+
+    The safe default's exits are listed in the order ``aarecovery.plan.analysis.analyse``
+    takes them; the value is the name reports print. A ``str`` enum, so that a report's
+    column and a comparison with the name as text both work.
+    """
+
+    PAPER = "paper"
+    """``mode="paper"``: the published method, no analysis."""
+    LOWPASS_KEPT = "lowpass-kept"
+    """F is a blur of O: its soft edges are the filter's intent, F is kept."""
+    AFFINE_KEPT = "affine-kept"
+    """F is an affine map of O on its edges: the edges are already right, F is kept."""
+    POINTWISE_HARD_EDGED = "pointwise-hard-edged"
+    """A point-wise filter on hard-edged content: full strength (and pure colours of thin
+    features when the table allows)."""
+    POINTWISE_CALIBRATED = "pointwise-calibrated"
+    """A point-wise filter on a textured image: the strength self-calibration finds, in the
+    regions that read as textured; full strength in those that read as hard-edged (text or
+    drawings over the photo: the local plan, ``aarecovery.spec.local_plan``)."""
+    NEIGHBOURHOOD_TEXTURED_KEPT = "neighbourhood-textured-kept"
+    """A filter that is neither point-wise nor a colour map, on a textured image: F is kept."""
+    COLOUR_MAP_KEPT = "colour-map-kept"
+    """A colour map on a textured image whose repairs would be no larger than the model's
+    own error: F is kept."""
+    COLOUR_MAP_CALIBRATED = "colour-map-calibrated"
+    """A colour map (a palette quantiser) on a textured image: the calibrated strength."""
+    NEIGHBOURHOOD_HARD_EDGED_KEPT = "neighbourhood-hard-edged-kept"
+    """A neighbourhood filter on hard-edged content whose repairs would be no larger than the
+    model's own error: F is kept."""
+    NEIGHBOURHOOD_HARD_EDGED = "neighbourhood-hard-edged"
+    """A neighbourhood filter on hard-edged content: the paper's passes at full strength."""
+
+    def __str__(self):
+        return self.value
 
 
 @dataclass(frozen=True)
@@ -35,6 +74,14 @@ class Plan:
     mode : {"safe", "paper"}
     reason : str
         One line saying why, for messages and the evaluation report.
+    decision : Decision
+        Which exit of the plan was taken, by name.
+    local : LocalStrength or None
+        The local plan (``aarecovery.spec.local_plan``): a per-pixel factor of ``beta``, read
+        from O, on top of `strength`; None: `strength` alone, everywhere.
+    forcing : Forcing or None
+        Where the safe default keeps F: whether forcing a repair may help, and why or what
+        it risks (``aarecovery.plan.forcing``).
     """
 
     sigma_d: float
@@ -45,11 +92,20 @@ class Plan:
     pure_colours: object = None
     mode: str = "paper"
     reason: str = "the published method"
+    decision: Decision = Decision.PAPER
+    local: object = None
+    forcing: object = None
 
     @property
     def keeps_filtered(self):
         """bool: the plan returns F unchanged (strength 0)."""
         return self.strength == 0
+
+    @property
+    def reach(self):
+        """int: how far beyond the model's own neighbourhood the plan reads O (the local
+        plan's factor; 0 without one): a tile's extra halo."""
+        return 0 if self.local is None else self.local.reach
 
 
 @dataclass
@@ -66,14 +122,18 @@ class RecoveryMaps:
         Product of the Sobel magnitudes of O and F.
     residual : ndarray of float32, shape (H, W)
         Distance of O's colour from its two-colour blend.
+    strength : ndarray of float32, shape (H, W)
+        The plan's strength at each pixel, which multiplies the confidence: the local plan's
+        map, or the one strength everywhere.
     """
 
     alpha: np.ndarray
     beta: np.ndarray
     edge_strength: np.ndarray
     residual: np.ndarray
+    strength: np.ndarray
 
-    NAMES = ("alpha", "beta", "edge_strength", "residual")
+    NAMES = ("alpha", "beta", "edge_strength", "residual", "strength")
 
 
 @dataclass(frozen=True)

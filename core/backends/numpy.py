@@ -4,6 +4,7 @@ import numpy as np
 
 from ..contract import to_rgba_float
 from ..spec import BlendModel, from_working_space, recover_working, to_working_space
+from ..spec.local_plan import encoded_colour, strength_map
 from ..tiling import DEFAULT_TILES, halo_for
 from .base import Capabilities, ReadyResult, RecoveryMaps
 
@@ -15,7 +16,7 @@ __all__ = ["NumpyBackend"]
 _STRIP_ROWS = 64
 
 
-def _recover_in_strips(original, filtered, plan):
+def _recover_in_strips(original, filtered, plan, factor):
     height = original.shape[0]
     halo = halo_for(plan.iterations)
     recovered = np.empty_like(filtered)
@@ -24,7 +25,8 @@ def _recover_in_strips(original, filtered, plan):
         bottom = min(height, top + _STRIP_ROWS)
         start, stop = max(0, top - halo), min(height, bottom + halo)
         result, model = recover_working(original[start:stop], filtered[start:stop], plan.sigma_d, plan.sigma_e,
-                                        plan.iterations, plan.strength, plan.pure_colours, plan.blend_space)
+                                        plan.iterations, plan.strength, plan.pure_colours, plan.blend_space,
+                                        None if factor is None else factor[start:stop])
         inner = slice(top - start, top - start + bottom - top)
         recovered[top:bottom] = result[inner]
         columns.append([getattr(model, name)[inner] for name in BlendModel.MAP_FIELDS])
@@ -40,20 +42,25 @@ class NumpyBackend:
 
     def __init__(self):
         self._original = self._filtered = self._filtered_rgba = None
-        self._result = self._model = None
+        self._result = self._model = self._strength = None
+        self._encoded = None
 
     def load(self, original, o_layout, filtered, f_layout, linear_input, blend_space):
         self._space = dict(linear_input=linear_input, blend_space=blend_space)
         self._filtered_rgba = to_rgba_float(filtered, f_layout, "filtered")
-        self._original = to_working_space(to_rgba_float(original, o_layout, "original"), **self._space)
+        original_rgba = to_rgba_float(original, o_layout, "original")
+        self._encoded = encoded_colour(original_rgba, linear_input)
+        self._original = to_working_space(original_rgba, **self._space)
         self._filtered = to_working_space(self._filtered_rgba, **self._space)
-        self._result = self._model = None
+        self._result = self._model = self._strength = None
 
     def run(self, plan, maps):
-        recovered, model = _recover_in_strips(self._original, self._filtered, plan)
+        factor = None if plan.local is None else plan.local.factor(self._encoded)
+        recovered, model = _recover_in_strips(self._original, self._filtered, plan, factor)
         self._result = from_working_space(recovered, self._filtered_rgba, filtered_work=self._filtered,
                                           **self._space)
         self._model = model
+        self._strength = strength_map(plan, factor, self._original.shape[:2]) if maps else None
 
     def finish(self):
         pass
@@ -63,7 +70,7 @@ class NumpyBackend:
 
     def read_maps(self):
         m = self._model
-        return RecoveryMaps(m.alpha, m.beta, m.edge, m.residual)
+        return RecoveryMaps(m.alpha, m.beta, m.edge, m.residual, self._strength)
 
     def release(self):
         self.__init__()

@@ -164,7 +164,7 @@ def recover_many(pairs, output=None, *, filter=None, filter_params=None, filter_
     list of ImageResult
         One per pair, in order: ``status`` (``"done"``, ``"skipped"``, ``"failed"``),
         ``error``, ``output``, the plan (``mode``, ``blend_space``, ``strength``,
-        ``reason``), ``backend``, ``seconds``, and ``image`` without `output`.
+        ``decision``, ``reason``), ``backend``, ``seconds``, and ``image`` without `output`.
 
     Examples
     --------

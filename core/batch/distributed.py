@@ -161,8 +161,9 @@ def _run_streamed(client, work, settings):
         return result
     window = deque()
     try:
-        side = stream.stream_tile(stream.resolve_tile(work.capabilities, settings.tile_size), work.plan.iterations)
-        halo = halo_for(work.plan.iterations)
+        side = stream.stream_tile(stream.resolve_tile(work.capabilities, settings.tile_size), work.plan.iterations,
+                                  work.plan.reach)
+        halo = halo_for(work.plan.iterations, work.plan.reach)
         grid = deque(aligned_tiles(work.pair.height, work.pair.width, side, halo))
         writer = TiledTiffWriter(work.target, work.pair.result_shape, work.pair.result_dtype, side)
         plan = client.scatter(work.plan, broadcast=True)

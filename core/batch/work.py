@@ -98,9 +98,10 @@ class ImageResult:
     width, height : int or None
     dtype : str
         R's dtype (the filtered image's).
-    mode, blend_space, reason : str
+    mode, blend_space, decision, reason : str
     strength : float or None
-        The plan: 0 means F was kept as it is, and `reason` says why.
+        The plan: 0 means F was kept as it is; `decision` names the plan's exit and `reason`
+        says why.
     backend : str
         ``"gl"`` or ``"numpy"``.
     streamed : bool
@@ -123,6 +124,7 @@ class ImageResult:
     mode: str = ""
     blend_space: str = ""
     strength: float = None
+    decision: str = ""
     reason: str = ""
     backend: str = ""
     streamed: bool = False
@@ -323,6 +325,7 @@ def _prepare(work, settings, capabilities, started, planner):
     plan = work.plan
     result.mode, result.blend_space, result.strength, result.reason = (plan.mode, plan.blend_space, plan.strength,
                                                                       plan.reason)
+    result.decision = str(plan.decision)
 
 
 def compute(work, engine, settings):

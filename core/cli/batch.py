@@ -73,7 +73,7 @@ def register(subparsers):
     parser.add_argument("--force", action="store_true",
                         help="redo results that are complete and newer than their inputs")
     parser.add_argument("--report", metavar="FILE",
-                        help="write per image the time, size, plan (mode, blend space, strength, reason) and "
+                        help="write per image the time, size, plan (mode, blend space, strength, decision, reason) and "
                              "backend to FILE (.csv or .json)")
     parser.add_argument("--workers", type=int, metavar="N",
                         help="analysis processes beside the engine, and N + 1 threads that read, filter and "

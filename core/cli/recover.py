@@ -33,6 +33,9 @@ maps (--maps DIR), 16-bit grey PNGs, white = 1:
                      ORIGINAL and FILTERED (a black/white edge ~0.87; sigma-e 0.01 ~0.1)
   residual.png       10 x distance of ORIGINAL's colour from its two-colour blend
                      (white at 0.1, the default sigma-d)
+  strength.png       the strength that multiplied the confidence at each pixel: the safe
+                     default's per-region map (full where text and drawings, the
+                     calibrated strength on a photo), as is
 
 examples:
   aarecovery recover photo.png thresholded.png -o repaired.png
@@ -53,7 +56,7 @@ def register(subparsers):
                         help="where to write the result; its folder must exist")
     add_recovery_options(parser)
     parser.add_argument("--maps", metavar="DIR",
-                        help="also write alpha, beta, edge_strength and residual maps as 16-bit PNGs "
+                        help="also write alpha, beta, edge_strength, residual and strength maps as 16-bit PNGs "
                              "into DIR (created if missing); scales below")
     parser.add_argument("--overwrite", action="store_true",
                         help="allow OUTPUT to replace ORIGINAL or FILTERED (any other existing file "
@@ -168,16 +171,16 @@ def run(args):
     if args.maps is not None:
         message += f"; maps in {args.maps}"
     print(printable(message))
-    print(summary_line(plan, original, filtered, result))
+    print(summary_line(plan, original, filtered, result, linear=args.linear))
     return 0
 
 
-def summary_line(plan, original=None, filtered=None, recovered=None):
+def summary_line(plan, original=None, filtered=None, recovered=None, linear=False):
     """What the recovery did, in the command line's words (the plan alone for a streamed pair)."""
     from ..outcome import RecoverySummary, summarize_recovery
 
     summary = (RecoverySummary(plan, None, None) if recovered is None
-               else summarize_recovery(plan, original, filtered, recovered))
+               else summarize_recovery(plan, original, filtered, recovered, linear))
     return summary.line(force="--strength 1")
 
 

@@ -11,7 +11,7 @@ __all__ = ["MAP_SCALES", "map_paths", "maps_as_images", "write_maps"]
 #: Factor each map is multiplied by before it is clipped to [0, 1] and stored as 16-bit
 #: grey; ``"sqrt"`` stores the square root, the geometric mean of O's and F's Sobel
 #: magnitudes, which makes the weak edges that sigma_e decides about visible.
-MAP_SCALES = {"alpha": 1.0, "beta": 1.0, "edge_strength": "sqrt", "residual": 10.0}
+MAP_SCALES = {"alpha": 1.0, "beta": 1.0, "edge_strength": "sqrt", "residual": 10.0, "strength": 1.0}
 
 
 def map_paths(folder):

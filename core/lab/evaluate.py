@@ -76,7 +76,7 @@ class CaseResult:
     reduction : dict of str to float
         Edge-band error reduction per method (not for ``"F"``).
     plan : str
-        What the safe default decided.
+        What the safe default decided: the decision's name, then its reason.
     images : dict of str to ndarray
         O, F, reference and every result, kept for the report's crops.
     """
@@ -170,7 +170,8 @@ def run_suite(suite, *, backend="numpy", peers=True, progress=False, keep_images
                    "paper": recover(o, f, backend=backend, mode="paper")}
         if keep_images:  # the reason is only shown in reports; planning again costs ~0.1 s a case
             opaque = np.ones(o.shape[:2] + (1,), np.float32)
-            result.plan = analyse(np.concatenate([o, opaque], -1), np.concatenate([f, opaque], -1)).reason
+            analysis = analyse(np.concatenate([o, opaque], -1), np.concatenate([f, opaque], -1))
+            result.plan = f"{analysis.decision}: {analysis.reason}"
         for method, image in outputs.items():
             _measure(result, method, image, ref, band, f, psnr, ssim_map, error_reduction)
         if keep_images:

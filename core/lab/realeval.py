@@ -104,14 +104,14 @@ class RealCaseResult(CaseResult):
 
 
 def _recover_both(engine, original, filtered):
-    """R (safe default) and paper, and the safe plan's reason, as ``recover`` makes them on one tile."""
+    """R (safe default), paper, and the safe plan (its decision and reason), as ``recover`` makes them on one tile."""
     engine.set_images(original, filtered)
     outputs = {}
     reason = ""
     for mode in ("safe", "paper"):
         plan = engine.plan(mode=mode)
         if mode == "safe":
-            reason = plan.reason
+            reason = f"{plan.decision}: {plan.reason}"
         if plan.keeps_filtered:
             outputs[mode] = filtered.copy()
         else:

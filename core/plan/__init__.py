@@ -7,11 +7,11 @@ Either way the result is a :class:`~aarecovery.backends.base.Plan` that the engi
 every backend take as it is.
 """
 
-from ..backends.base import Plan
+from ..backends.base import Decision, Plan
 from ..params import check_blend_space, check_mode
 from .analysis import PairAnalysis, analyse, analyse_pair
 
-__all__ = ["make_plan", "Plan", "PairAnalysis", "analyse", "analyse_pair"]
+__all__ = ["make_plan", "Decision", "Plan", "PairAnalysis", "analyse", "analyse_pair"]
 
 
 def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blend_space=None, analysis=None):
@@ -46,12 +46,13 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
         return Plan(**common, blend_space=blend_space or "linear", mode="paper",
                     strength=1.0 if asked is None else asked,
                     reason="the published method (Yang et al. 2011), without the safe default's analysis"
-                           + ("" if asked is None else f"; strength {asked:g} as asked"))
+                           + ("" if asked is None else f"; strength {asked:g} as asked"), decision=Decision.PAPER)
     if analysis is None:
         analysis = analyse_pair(original, filtered, linear)
-    # A strength the user gives overrides the analysis's, and forces a repair where it keeps
-    # F; the other decisions (blend space, pure colours) stand.
+    # A strength the user gives overrides the analysis's, and its local plan, and forces a
+    # repair where it keeps F; the other decisions (blend space, pure colours) stand.
     return Plan(**common, blend_space=blend_space or analysis.blend_space,
                 strength=analysis.strength if asked is None else asked, pure_colours=analysis.pure_colours,
-                mode="safe", reason=analysis.reason + ("" if asked is None else
-                                                       f"; strength {asked:g} as asked instead"))
+                mode="safe", decision=analysis.decision, local=analysis.local if asked is None else None,
+                forcing=analysis.forcing,
+                reason=analysis.reason + ("" if asked is None else f"; strength {asked:g} as asked instead"))

@@ -3,22 +3,34 @@
 The paper's method (``mode="paper"``) harms some inputs measurably (``docs/quality.md``):
 Gaussian blur, whose soft edges it re-sharpens, and natural photos under smooth filters,
 whose texture the two-colour model flattens. A user cannot know which case they are in,
-so ``mode="safe"`` first looks at the pair as a whole and decides, in this order:
+so ``mode="safe"`` first looks at the pair as a whole and decides. It chooses the **blend
+space** first (``blend_space``: linear light or sRGB values, from which space O's edges fit
+colour lines better), then takes the first of these exits that applies, each named by a
+:class:`~aarecovery.backends.base.Decision`:
 
-1. **Blend space** (``blend_space``): linear light or sRGB values, from which space O's
-   edges fit colour lines better.
-2. **Low-pass filters** (``lowpass``): if F is a blur of O, F's soft edges are the filter's
+1. ``LOWPASS_KEPT`` (``lowpass``): F is a blur of O; F's soft edges are the filter's
    intent and F is kept.
-3. **Point-wise filters** (``pointwise``): when ``F = f(O)`` for a fitted table, hard-edged
-   content gets full strength and, for a monotone table, the pure colours of thin features
-   (``pure_colours``); textured content (a photo) gets the strength that
-   self-calibration at half resolution finds safe (``calibration``).
-4. **Other filters on textured images**: a colour map of all three channels at once (a
-   palette quantiser; ``colour_map``) is calibrated like a table when its repairs exceed
-   the model's own error carried through the filter (``model_error``); any other filter
-   cannot be simulated and the model would flatten the texture: F is kept. On hard-edged
-   content the paper's passes run, unless the repairs they would make are no larger than
-   the model's own error: then F is kept.
+2. ``AFFINE_KEPT`` (``linearity``): F is an affine map of O on O's edges; they are already
+   right and F is kept.
+3. ``POINTWISE_HARD_EDGED`` (``pointwise``, ``texture``): ``F = f(O)`` for a fitted table
+   on hard-edged content: full strength and, for a monotone table, the pure colours of
+   thin features (``pure_colours``).
+4. ``POINTWISE_CALIBRATED``: the same on textured content (a photo): the strength that
+   self-calibration at half resolution finds safe (``calibration``), in the regions that
+   read as textured, and full strength in those that read as hard-edged (text, logos and
+   lines drawn over the photo): the local plan (``aarecovery.spec.local_plan``), which the
+   backends apply per tile.
+5. ``NEIGHBOURHOOD_TEXTURED_KEPT``: any other filter on a textured image that is not a
+   colour map of all three channels at once (``colour_map``): it cannot be simulated and
+   the model would flatten the texture, F is kept.
+6. ``COLOUR_MAP_KEPT``: a colour map on a textured image whose repairs are no larger than
+   the model's own error carried through the filter (``model_error``): F is kept.
+7. ``COLOUR_MAP_CALIBRATED``: a colour map (a palette quantiser) on a textured image: the
+   calibrated strength, as for a table.
+8. ``NEIGHBOURHOOD_HARD_EDGED_KEPT``: a neighbourhood filter on hard-edged content whose
+   repairs are no larger than the model's own error: F is kept.
+9. ``NEIGHBOURHOOD_HARD_EDGED``: a neighbourhood filter on hard-edged content: the paper's
+   passes at full strength.
 
 All of it runs once, in NumPy, on a central crop, before tiling, and results in a
 :class:`PairAnalysis` that ``aarecovery.plan.make_plan`` turns into the backends' Plan.
@@ -26,13 +38,16 @@ All of it runs once, in NumPy, on a central crop, before tiling, and results in 
 
 from dataclasses import dataclass
 
+from ..backends.base import Decision
 from ..colour import linear_to_srgb
 from ..contract import layout_of, to_rgba_float
 from ..params import ITERATIONS, SIGMA_D, SIGMA_E
+from ..spec.local_plan import LocalStrength
 from ..spec.sobel import gradient_magnitude
 from .blend_space import choose_blend_space
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
+from .forcing import forcing_advice
 from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
@@ -63,15 +78,25 @@ class PairAnalysis:
         Multiplies the confidence ``beta``; 0 returns F unchanged, 1 is the paper's method.
     reason : str
         One line saying why, for messages and the evaluation report.
+    decision : Decision
+        Which exit was taken, by name.
     pure_colours : PureColourPrior or None
         For point-wise filters on hard-edged content: the filter's table and O's flat
         colours, with which the passes restore thin features.
+    local : LocalStrength or None
+        The local plan: `strength` is then the hard-edged regions' and ``local.textured``
+        the textured regions'.
+    forcing : Forcing or None
+        Where F is kept: what forcing a repair would do (``aarecovery.plan.forcing``).
     """
 
     blend_space: str
     strength: float
     reason: str
+    decision: Decision
     pure_colours: object = None
+    local: object = None
+    forcing: object = None
 
 
 def analysis_crop(image):
@@ -110,6 +135,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     Returns
     -------
     PairAnalysis
+        Its ``decision`` names the exit taken; the module's docstring lists them in order.
     """
     o_rgba = analysis_crop(original_rgba)
     f_rgba = analysis_crop(filtered_rgba)
@@ -120,12 +146,14 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     fit = residuals[space]
     lowpass, kernel_residual, _ = fit_lowpass(o, f)
     if lowpass:
-        return PairAnalysis(space, 0.0, f"F is a low-pass (blur) of O (kernel residual {kernel_residual:.3f}): kept F")
+        return PairAnalysis(space, 0.0, f"F is a low-pass (blur) of O (kernel residual {kernel_residual:.3f}): kept F",
+                            Decision.LOWPASS_KEPT, forcing=forcing_advice(Decision.LOWPASS_KEPT))
     edges = gradient_magnitude(o) >= EDGE_GRADIENT
     affine = affine_share(o, f, edges, space)
     if affine >= AFFINE_SHARE:
         return PairAnalysis(space, 0.0, f"F is an affine map of O in {space} values on {affine:.3f} of the edges, "
-                                        "so its edges are already right: kept F")
+                                        "so its edges are already right: kept F", Decision.AFFINE_KEPT,
+                            forcing=forcing_advice(Decision.AFFINE_KEPT))
     transfer = fit_pointwise(o, f, edges)
     textured, texture = is_textured(o, fit)
     if transfer.consistency >= POINTWISE_SHARE and not textured:
@@ -139,18 +167,29 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         prior = pure_colour_prior(o, transfer, space, f, edges)
         return PairAnalysis(space, 1.0, f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges "
                                         "match) on hard-edged content: full strength"
-                                        + (", pure colours of thin features" if prior is not None else ""), prior)
+                                        + (", pure colours of thin features" if prior is not None else ""),
+                            Decision.POINTWISE_HARD_EDGED, prior)
     if transfer.consistency >= POINTWISE_SHARE:
-        strength, _ = calibrate_strength(o, transfer, f, space, sigma_d, sigma_e, iterations)
-        return PairAnalysis(space, strength,
-                            f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges match); "
-                            f"half-resolution calibration chose strength {strength:g}")
+        strength, errors = calibrate_strength(o, transfer, f, space, sigma_d, sigma_e, iterations)
+        why = (f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges match); "
+               f"half-resolution calibration chose strength {strength:g}")
+        if not 0 < strength < 1:
+            return PairAnalysis(space, strength, why, Decision.POINTWISE_CALIBRATED,
+                                forcing=forcing_advice(Decision.POINTWISE_CALIBRATED, errors=errors) if strength == 0
+                                else None)
+        # Where the calibration found a repair safe, the regions that read as hard-edged
+        # (text over the photo) get full strength: mixed scenes' graphics 0.479 -> 0.609 of
+        # their edge error removed, photo regions 0.367 -> 0.365 (tuning half). Where it
+        # found none (strength 0), F is kept everywhere, as before.
+        return PairAnalysis(space, 1.0, why + " for textured regions, full strength for hard-edged ones",
+                            Decision.POINTWISE_CALIBRATED, local=LocalStrength(strength))
     if textured:
         colour_map = fit_colour_map(o, f, edges)
         if colour_map.consistency < COLOUR_MAP_SHARE:
             return PairAnalysis(space, _PHOTO_NEIGHBOURHOOD_STRENGTH,
                                 f"neighbourhood filter on a textured image ({texture}): "
-                                f"strength {_PHOTO_NEIGHBOURHOOD_STRENGTH:g}")
+                                f"strength {_PHOTO_NEIGHBOURHOOD_STRENGTH:g}", Decision.NEIGHBOURHOOD_TEXTURED_KEPT,
+                                forcing=forcing_advice(Decision.NEIGHBOURHOOD_TEXTURED_KEPT))
         # A colour map that bends colours smoothly (a hue change) leaves repairs no larger
         # than the model's error; calibration alone chose 0.5 there and lost 0.73 dB (GEGL's
         # hue-chroma on maps, quick tuning half: ratio 1.18); the held-out quantised photos
@@ -159,18 +198,23 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         if ratio < MIN_REPAIR_TO_ERROR:
             return PairAnalysis(space, 0.0, f"point-wise colour map ({colour_map.consistency:.3f} of edges match) on "
                                             f"a textured image, but the repairs would be no larger than the model's "
-                                            f"own error (ratio {ratio:.2f} < {MIN_REPAIR_TO_ERROR:g}): kept F")
-        strength, _ = calibrate_strength(o, colour_map, f, space, sigma_d, sigma_e, iterations)
+                                            f"own error (ratio {ratio:.2f} < {MIN_REPAIR_TO_ERROR:g}): kept F",
+                                Decision.COLOUR_MAP_KEPT, forcing=forcing_advice(Decision.COLOUR_MAP_KEPT, ratio))
+        strength, errors = calibrate_strength(o, colour_map, f, space, sigma_d, sigma_e, iterations)
         return PairAnalysis(space, strength,
                             f"point-wise colour map ({colour_map.consistency:.3f} of edges match, repair-to-error "
-                            f"ratio {ratio:.1f}); half-resolution calibration chose strength {strength:g}")
+                            f"ratio {ratio:.1f}); half-resolution calibration chose strength {strength:g}",
+                            Decision.COLOUR_MAP_CALIBRATED,
+                            forcing=forcing_advice(Decision.COLOUR_MAP_CALIBRATED, errors=errors) if strength == 0
+                            else None)
     ratio = _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e)
     if ratio < MIN_REPAIR_TO_ERROR:
         return PairAnalysis(space, 0.0, f"neighbourhood filter on hard-edged content, but the repairs would be "
                                         f"no larger than the model's own error (ratio {ratio:.2f} < "
-                                        f"{MIN_REPAIR_TO_ERROR:g}): kept F")
+                                        f"{MIN_REPAIR_TO_ERROR:g}): kept F", Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT,
+                            forcing=forcing_advice(Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT, ratio))
     return PairAnalysis(space, 1.0, f"neighbourhood filter on hard-edged content (repair-to-error ratio "
-                                    f"{ratio:.1f}): full strength")
+                                    f"{ratio:.1f}): full strength", Decision.NEIGHBOURHOOD_HARD_EDGED)
 
 
 def _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e):

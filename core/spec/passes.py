@@ -12,6 +12,8 @@ Each function is one pass, and the GL backend has a shader pass of the same name
 :func:`recover_working` runs steps 2 and 3; it is the one place the Jacobi loop is written.
 """
 
+import numpy as np
+
 from .blend_model import fit_paper_model
 from .jacobi import jacobi_step
 from .pure_colours import fit_pure_colour_model
@@ -20,7 +22,8 @@ from .working_space import from_working_space, to_working_space
 __all__ = ["to_working_space", "fit_blend_model", "jacobi_step", "from_working_space", "recover_working"]
 
 
-def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=None, blend_space="linear"):
+def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=None, blend_space="linear",
+                    factor=None):
     """Fit the two-colour blend model at every pixel of O (section 3.1) and its confidence.
 
     The GL pass of this name also writes the first Jacobi iterate, which it can form from
@@ -41,18 +44,25 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
     blend_space : {"linear", "srgb"}
         The working space's colour space, needed only with `prior` (its table is on
         sRGB-encoded values).
+    factor : ndarray of float32, shape (H, W), optional
+        The local plan's per-pixel factor of ``beta`` (``aarecovery.spec.local_plan``),
+        applied after `strength`; None leaves ``beta`` as it is.
 
     Returns
     -------
     BlendModel
     """
     if prior is None:
-        return fit_paper_model(original, filtered, sigma_d, sigma_e, strength)
-    return fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space)
+        model = fit_paper_model(original, filtered, sigma_d, sigma_e, strength)
+    else:
+        model = fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space)
+    if factor is not None:
+        model.beta = (model.beta * factor).astype(np.float32)
+    return model
 
 
 def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1.0, prior=None,
-                    blend_space="linear"):
+                    blend_space="linear", factor=None):
     """Fit the model and run the Jacobi iterations on working-space images.
 
     Parameters are those of :func:`fit_blend_model`, and `iterations` (0 returns F).
@@ -62,7 +72,7 @@ def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1
     recovered : ndarray of float32, shape (H, W, 4)
     model : BlendModel
     """
-    model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space)
+    model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, factor)
     recovered = filtered
     for _ in range(iterations):
         recovered = jacobi_step(recovered, filtered, model)

@@ -48,7 +48,7 @@ def test_plan_line_gives_the_share_of_edge_pixels_repaired_once_summarized(plan_
     assert asked.detail.endswith("; strength 0.5 as asked instead")
 
 
-def test_plan_line_says_f_is_kept_and_how_to_force_a_repair(plan_line, original):
+def test_plan_line_says_f_is_kept_and_what_forcing_risks(plan_line, original):
     with aarecovery.Engine(backend="numpy") as engine:
         engine.set_images(original, aarecovery.filters.apply("blur", original))
         engine.compute()
@@ -56,5 +56,6 @@ def test_plan_line_says_f_is_kept_and_how_to_force_a_repair(plan_line, original)
         assert engine.last_plan.strength == 0
         engine.compute(mode="paper")
         paper = plan_line(engine)
-    assert kept.text == "safe: F is a low-pass of O, F shown unchanged, untick auto strength to force a repair"
+    assert kept.text == ("safe: F is a low-pass of O, F shown unchanged, forcing a repair risks re-sharpening the "
+                         "soft edges the blur made on purpose")
     assert paper.text == "paper: the published method, full strength, blend in linear light"

@@ -42,6 +42,7 @@ from collections import namedtuple
 import moderngl
 import numpy as np
 
+from ...spec.local_plan import strength_map
 from ...spec.pure_colours import PALETTE_SIZE
 from ...tiling import DEFAULT_TILES
 from ..base import Capabilities, ReadyResult, RecoveryMaps
@@ -58,9 +59,10 @@ EngineTexture = namedtuple("EngineTexture", "texture channel linear")
 _CONVERT_NONE, _CONVERT_DECODE, _CONVERT_ENCODE = 0, 1, 2
 # Where each map lives: (texture key, channel).
 _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("model", 3),
-                 "edge_strength": ("edge", 0)}
+                 "edge_strength": ("edge", 0), "strength": ("strength", 0)}
 # The textures made when first needed: (components, dtype); "result" has F's.
 _WORK_TEXTURES = {"original_work": (4, "f4"), "filtered_work": (4, "f4"), "model": (4, "f4"), "edge": (1, "f4"),
+                  "local_flat": (1, "f4"), "local_rows": (1, "f4"), "strength_factor": (1, "f4"), "strength": (1, "f4"),
                   "fixed_a": (4, "f4"), "fixed_b": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4")}
 _RESULT_BITS = {np.dtype(np.uint8): 8, np.dtype(np.uint16): 16}
 
@@ -168,6 +170,7 @@ class GLBackend:
         # software renderer would only add a copy (llvmpipe computes on the CPU anyway).
         self._overlap_readback = not software_renderer(self.context)
         self._ran = None
+        self._factor_for = None
 
     # -- images -----------------------------------------------------------------------------
     @_current
@@ -180,6 +183,7 @@ class GLBackend:
             self._key = key
         self._upload("original", original, o_layout, o_dtype)
         self._upload("filtered", filtered, f_layout, f_dtype)
+        self._factor_for = None
         self._stage("upload")
         self._classified = set()
         self._working_lists = set()
@@ -341,8 +345,15 @@ class GLBackend:
         if prior is not None:
             sources["transfer_table"] = self._transfer_table(prior)
             uniforms.update(self._pure_colour_uniforms(prior))
-        defines = {**self._defines, "PURE_COLOURS": int(prior is not None)}
+        local = plan.local is not None
+        if local:
+            sources["strength_factor"] = self._work("strength_factor")
+        defines = {**self._defines, "PURE_COLOURS": int(prior is not None), "LOCAL_STRENGTH": int(local)}
         with self._passes():
+            if local:
+                self._local_factor(plan.local)
+            if maps:
+                self._strength_map(plan)
             if active not in self._working_lists:
                 self._to_working_space(lists, "dilated")
                 self._working_lists.add(active)
@@ -364,6 +375,27 @@ class GLBackend:
                 self._jacobi_steps(sources, defines, lists, plan.iterations)
         self._stage("passes")
         self._ran = {"maps": maps}
+
+    def _local_factor(self, local):
+        """The local plan's factor of beta for the loaded O, once per pair and plan (three passes)."""
+        if self._factor_for == local:
+            return
+        defines = {"LOCAL_ENCODE": int(self._linear["original"])}
+        steps = (({"original_image": self._textures["original"]}, "local_flat"),
+                 ({"local_input": self._work("local_flat")}, "local_rows"),
+                 ({"local_input": self._work("local_rows")}, "strength_factor"))
+        for number, (inputs, output) in enumerate(steps, 1):
+            self._path.run_pass("local_plan", inputs, [self._work(output)], uniforms={"textured": local.textured},
+                                defines={**defines, "LOCAL_PASS": number})
+        self._factor_for = local
+
+    def _strength_map(self, plan):
+        """The strength map of the maps: the plan's strength times the local factor (read back)."""
+        factor = None
+        if plan.local is not None:
+            factor = np.empty(self._key[0][::-1], np.float32)
+            self._work("strength_factor").read_into(factor)
+        self._work("strength").write(strength_map(plan, factor, self._key[0][::-1]))
 
     def _transfer_table(self, prior):
         """The filter's table (3 KB): per run, as it belongs to the plan, not to the loaded pair."""
@@ -461,8 +493,10 @@ class GLBackend:
         self._textures["model"].read_into(model)
         edge = np.empty((height, width), np.float32)
         self._textures["edge"].read_into(edge)
+        strength = np.empty((height, width), np.float32)
+        self._textures["strength"].read_into(strength)
         return RecoveryMaps(np.ascontiguousarray(model[..., 0]), np.ascontiguousarray(model[..., 1]), edge,
-                            np.ascontiguousarray(model[..., 3]))
+                            np.ascontiguousarray(model[..., 3]), strength)
 
     def texture(self, name):
         if name in ("result", "original", "filtered"):

@@ -6,6 +6,10 @@
 uniform float sigma_d;
 uniform float sigma_e;
 uniform float strength;  // the safe default's per-image repair strength; 1 for the paper
+#if LOCAL_STRENGTH
+// The local plan's per-pixel factor of beta (aarecovery.spec.local_plan), after the strength.
+uniform sampler2D strength_factor;
+#endif
 
 const float TINY = 1e-12;
 const float FAINT = 1e-30;
@@ -140,6 +144,9 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
 #endif
     fit.edge = edge;
     float beta = confidence(residual, edge);
+#if LOCAL_STRENGTH
+    beta *= texelFetch(strength_factor, p, 0).r;
+#endif
     fit.model = vec4(alpha, beta, code, residual);
     fit.first_iterate = beta * (alpha * f_a + (1.0 - alpha) * f_b) + (1.0 - beta) * f[0];
     return fit;

@@ -1,0 +1,141 @@
+"""The local plan: full strength where text and drawings lie over a photo, the calibrated
+strength on the photo, smooth between, the same tiled and untiled and on both backends."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import aarecovery
+from aarecovery import Decision
+from aarecovery.colour import srgb_to_linear
+from aarecovery.lab import scenes as _scenes
+from aarecovery.lab.groundtruth import make_case
+from aarecovery.spec.local_plan import LocalStrength, flat_share, hard_edged_weight
+
+# The banner's rows in O (a photo below it).
+_BANNER = 21
+
+
+@pytest.fixture(scope="module")
+def banner_over_photo():
+    """A photo with a flat banner of three dark text bars across its top, posterized."""
+    scene = _scenes.render("astronaut", 128, 4).copy()
+    scene[:_BANNER * 4] = (0.93, 0.9, 0.8)
+    for bar in range(3):
+        scene[8 + 16 * bar:14 + 16 * bar, 16:-16] = (0.1, 0.1, 0.3)
+    return make_case(scene, "posterize", 4, "linear")
+
+
+def test_the_plan_is_local_where_the_calibration_found_a_repair_safe(banner_over_photo):
+    case = banner_over_photo
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        plan = engine.plan()
+        forced = engine.plan(strength=0.5)
+    assert plan.decision == Decision.POINTWISE_CALIBRATED
+    assert plan.strength == 1 and 0 < plan.local.textured < 1
+    # A strength the user gives is the strength everywhere.
+    assert forced.local is None and forced.reach == 0
+
+
+def test_text_gets_full_strength_the_photo_the_calibrated_one(banner_over_photo):
+    case = banner_over_photo
+    with aarecovery.Engine("numpy") as engine:
+        _, maps = aarecovery.recover(case.original, case.filtered, engine=engine, return_maps=True)
+        textured = engine.last_plan.local.textured
+    strength = maps.strength
+    assert np.median(strength[2:_BANNER - 6]) > 0.95
+    assert np.median(strength[_BANNER + 12:]) == pytest.approx(textured)
+    assert strength.min() >= textured - 1e-6 and strength.max() <= 1 + 1e-6
+    # No seam: the strength changes over several pixels, never from one to the next.
+    for axis in (0, 1):
+        assert np.abs(np.diff(strength, axis=axis)).max() <= 0.5 * (1 - textured)
+
+
+def test_the_repair_is_better_on_the_text_and_the_same_on_the_photo(banner_over_photo):
+    from aarecovery.lab.metrics import edge_band, error_reduction
+    case = banner_over_photo
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        plan = engine.plan()
+        engine.run(plan)
+        local = engine.result()
+        engine.run(dataclasses.replace(plan, local=None, strength=plan.local.textured))
+        one_strength = engine.result()
+    band = edge_band(case.original, case.filtered, case.reference)
+    text, photo = band.copy(), band.copy()
+    text[_BANNER - 2:], photo[:_BANNER + 12] = False, False
+    gained = [error_reduction(image, case.filtered, case.reference, text) for image in (local, one_strength)]
+    assert gained[0] > gained[1] + 0.1 and gained[0] > 0.8, gained
+    kept = [error_reduction(image, case.filtered, case.reference, photo) for image in (local, one_strength)]
+    assert kept[0] == pytest.approx(kept[1], abs=0.02), kept
+
+
+@pytest.mark.filterwarnings("ignore::aarecovery.errors.TileSizeWarning")
+def test_tiled_equals_untiled_with_the_local_plan(banner_over_photo):
+    case = banner_over_photo
+    whole = aarecovery.recover(case.original, case.filtered, backend="numpy")
+    # 24-pixel tiles grow to hold the local plan's halo; tile borders then cross the banner.
+    for tile in (24, 40):
+        np.testing.assert_array_equal(aarecovery.recover(case.original, case.filtered, backend="numpy",
+                                                         tile_size=tile), whole)
+
+
+# The GLSL twin (local_plan.glsl) against the specification: the counts are exact in both,
+# the share, smoothstep and factor are float32 arithmetic in a different order.
+_FACTOR_TOLERANCE = 1e-6
+
+
+def _pairs(case):
+    to8 = lambda image: np.rint(image * 255).astype(np.uint8)
+    yield "float", case.original, case.filtered, False
+    yield "uint8", to8(case.original), to8(case.filtered), False
+    yield "linear", srgb_to_linear(case.original), srgb_to_linear(case.filtered), True
+
+
+@pytest.mark.filterwarnings("ignore::aarecovery.errors.TileSizeWarning")
+def test_gl_computes_the_same_strength_map_as_numpy(banner_over_photo, gl_path):
+    for name, original, filtered, linear in _pairs(banner_over_photo):
+        with aarecovery.Engine("numpy") as engine:
+            engine.set_images(original, filtered, linear=linear)
+            plan = engine.plan()
+        assert plan.local is not None, name
+        results = {}
+        for backend in ("numpy", "gl"):
+            with aarecovery.Engine(backend, gl_path=gl_path if backend == "gl" else "auto") as engine:
+                results[backend] = aarecovery.recover(original, filtered, engine=engine, linear=linear,
+                                                      return_maps=True)
+        (numpy_result, numpy_maps), (gl_result, gl_maps) = results["numpy"], results["gl"]
+        np.testing.assert_allclose(gl_maps.strength, numpy_maps.strength, atol=_FACTOR_TOLERANCE, err_msg=name)
+        assert np.abs(numpy_maps.strength - plan.local.textured).max() > 0.3, name
+        np.testing.assert_allclose(gl_maps.beta, numpy_maps.beta, atol=1e-5, err_msg=name)
+        # The stated tolerances of the parity tests: one 8-bit level, 1e-5 on float.
+        np.testing.assert_allclose(gl_result.astype(np.float64), numpy_result, atol=1 if name == "uint8" else 1e-5,
+                                   err_msg=name)
+        tiled, tiled_maps = aarecovery.recover(original, filtered, backend="gl", gl_path=gl_path, linear=linear,
+                                               tile_size=40, return_maps=True)
+        np.testing.assert_array_equal(tiled, gl_result, err_msg=name)
+        np.testing.assert_allclose(tiled_maps.strength, gl_maps.strength, atol=_FACTOR_TOLERANCE, err_msg=name)
+
+
+def test_the_summary_says_how_the_image_divided(banner_over_photo):
+    case = banner_over_photo
+    with aarecovery.Engine("numpy") as engine:
+        recovered = aarecovery.recover(case.original, case.filtered, engine=engine)
+        summary = aarecovery.summarize_recovery(engine.last_plan, case.original, case.filtered, recovered)
+        textured = engine.last_plan.local.textured
+    assert 0.05 < summary.hard_edged_share < 0.6
+    assert (f"text and drawings {summary.hard_edged_share:.0%} of the edges at strength 1, "
+            f"photo {1 - summary.hard_edged_share:.0%} at {textured:g}") in summary.line()
+
+
+def test_flat_regions_read_as_hard_edged_and_grain_and_black_as_textured():
+    rng = np.random.default_rng(3)
+    image = np.full((48, 96, 3), 0.8, np.float32)
+    image[:, 48:] = np.rint(rng.uniform(0.3, 0.7, (48, 48, 3)) * 255) / 255
+    weight = hard_edged_weight(flat_share(image))
+    assert (weight[:, :30] == 1).all() and (weight[:, 66:] == 0).all()
+    assert (hard_edged_weight(flat_share(np.zeros((32, 32, 3), np.float32))) == 0).all()
+    factor = LocalStrength(0.25).factor(image)
+    assert factor[:, :30].min() == 1 and factor[:, 66:].max() == np.float32(0.25)

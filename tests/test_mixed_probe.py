@@ -1,0 +1,38 @@
+"""The mixed scenes the local plan is measured on: a photo with graphics drawn over it, under
+a real tool, scored per region (text and graphics, photo)."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import aarecovery
+from aarecovery.lab.mixed_probe import MIXED_SPLIT, build_mixed_cases, measure_regions, mixed_scene
+from test_realtools import require_tool
+
+
+def test_the_halves_share_no_photo_and_no_filter():
+    (tune_photos, tune_filters), (held_photos, held_filters) = MIXED_SPLIT["tune"], MIXED_SPLIT["heldout"]
+    assert not set(tune_photos) & set(held_photos) and not set(tune_filters) & set(held_filters)
+
+
+def test_the_graphics_cover_part_of_the_photo():
+    scene, coverage = mixed_scene("coffee")
+    assert scene.shape == (coverage.shape[0] * 8, coverage.shape[1] * 8, 3)
+    assert 0.1 < (coverage > 0.02).mean() < 0.5
+
+
+def test_the_local_plan_repairs_the_graphics_more_and_the_photo_as_much():
+    require_tool("gegl")
+    (case,) = build_mixed_cases("tune", photos=("coffee",), filters=("gegl-threshold",))
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        plan = engine.plan()
+        assert plan.local is not None, plan.reason
+        engine.run(plan)
+        local = measure_regions(case, engine.result())
+        engine.run(dataclasses.replace(plan, local=None, strength=plan.local.textured))
+        one_strength = measure_regions(case, engine.result())
+    assert local["graphics"] > one_strength["graphics"] + 0.05, (local, one_strength)
+    assert local["photo"] == pytest.approx(one_strength["photo"], abs=0.02) and local["photo"] > 0
+    assert np.isfinite(list(local.values())).all()
