@@ -10,6 +10,7 @@ from ..params import (DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, STRENGTH, Para
                       check_blend_space, check_gl_path, check_mode)
 from ..tiling import check_tile_size
 from . import storage
+from .destinations import check_batch_destinations
 from .filtering import BuiltinFilter, FilterCommand
 from .jobs import Job, output_name
 from .local import run_local
@@ -179,6 +180,7 @@ def recover_many(pairs, output=None, *, filter=None, filter_params=None, filter_
                              tile_size=tile_size, mode=mode, strength=strength, gl_path=gl_path,
                              max_bytes=max_bytes)
     jobs = make_jobs(pairs, settings.filter is not None)
+    check_batch_destinations(jobs, settings)
     return run_jobs(jobs, settings, workers=workers, progress=progress, dask=dask, engine=engine)
 
 

@@ -96,6 +96,15 @@ class FilterCommand:
     def describe(self):
         return self.template
 
+    def _chosen_extension(self):
+        """The extension the template gives ``{out}`` (``{out}.png``), or None."""
+        chosen = re.search(r"\{out\}(\.\w+)", self.template)
+        return chosen.group(1) if chosen else None
+
+    def output_extension(self, original_path):
+        """The extension of the file the command writes for `original_path` (``".png"``)."""
+        return self._chosen_extension() or os.path.splitext(original_path)[1]
+
     def run(self, original_path, folder):
         """Run the command on a copy of `original_path` inside `folder`; return the output's path.
 
@@ -104,13 +113,11 @@ class FilterCommand:
         FilterFailed
             On a non-zero exit status, a time-out, or no output file.
         """
-        extension = os.path.splitext(original_path)[1]
-        copy = os.path.join(folder, "original" + extension)
+        copy = os.path.join(folder, "original" + os.path.splitext(original_path)[1])
         shutil.copyfile(original_path, copy)
-        chosen = re.search(r"\{out\}(\.\w+)", self.template)
         output = os.path.join(folder, "filtered")
-        produced = output + (chosen.group(1) if chosen else extension)
-        target = output if chosen else produced
+        produced = output + self.output_extension(original_path)
+        target = output if self._chosen_extension() else produced
         words = [word.replace("{in}", copy).replace("{out}", target) for word in self.words()]
         returncode, stderr = _run_as_group(words, self.timeout, folder, self.template)
         # Without terminal colour codes (G'MIC colours its messages).

@@ -204,13 +204,6 @@ def _is_path(value):
     return isinstance(value, (str, os.PathLike))
 
 
-def _same_file(first, second):
-    try:
-        return os.path.samefile(first, second)
-    except OSError:
-        return os.path.realpath(first) == os.path.realpath(second)
-
-
 def _up_to_date(output, inputs):
     """The result exists (so it is complete: every write is atomic) and is newer than its inputs."""
     made = storage.modified(output)
@@ -236,7 +229,20 @@ def remove_stale_parts(output, before):
 
 def _kept_path(folder, name, extension=None):
     stem, own = os.path.splitext(name)
-    return os.path.join(folder, *(stem + (extension or own)).split("/"))
+    return os.path.join(folder, *(stem + (own if extension is None else extension)).split("/"))
+
+
+def kept_filtered_path(settings, job):
+    """Where the filtered image the batch makes for `job` is kept (``settings.keep_filtered``)."""
+    if isinstance(settings.filter, FilterCommand):
+        original = os.fspath(job.original) if _is_path(job.original) else job.name
+        return _kept_path(settings.keep_filtered, job.name, settings.filter.output_extension(original))
+    return _kept_path(settings.keep_filtered, job.name)
+
+
+def maps_folder(settings, job):
+    """The folder `job`'s maps are written into (``settings.maps``/NAME without its extension)."""
+    return _kept_path(settings.maps, job.name, "")
 
 
 def prepare(job, settings, capabilities, started, planner=make_plan):
@@ -269,11 +275,6 @@ def _prepare(work, settings, capabilities, started, planner):
     inputs = [os.fspath(path) for path in (job.original, job.filtered) if _is_path(path)]
     if settings.output is not None:
         work.output = work.target = storage.join(settings.output, output_name(job.name, settings.format))
-        for role, path in zip(("original", "filtered"), (job.original, job.filtered)):
-            if _is_path(path) and not settings.overwrite and not storage.is_url(path) and \
-                    not storage.is_url(work.output) and _same_file(work.output, path):
-                raise InputError(f"the result {work.output} would replace the {role} image; choose another "
-                                 "output folder, or pass --overwrite")
         remove_stale_parts(work.output, started)
         if not settings.force and inputs and _up_to_date(work.output, inputs):
             result.status, result.output = "skipped", work.output
@@ -362,7 +363,7 @@ def store(work, settings):
                 storage.publish(work.target, work.output)
             _keep_filtered(work, settings)
             if settings.maps is not None and work.maps is not None:
-                folder = _kept_path(settings.maps, work.job.name, "")
+                folder = maps_folder(settings, work.job)
                 os.makedirs(folder, exist_ok=True)
                 write_maps(folder, work.maps)
         result.output = work.output
@@ -378,7 +379,7 @@ def _keep_filtered(work, settings):
     if settings.keep_filtered is None or work.job.filtered is not None:
         return
     if work.filtered_file is not None:
-        kept = _kept_path(settings.keep_filtered, work.job.name, os.path.splitext(work.filtered_file)[1])
+        kept = kept_filtered_path(settings, work.job)
         os.makedirs(os.path.dirname(kept), exist_ok=True)
         # The tool's own file, byte for byte, renamed into place.
         descriptor, temporary = tempfile.mkstemp(dir=os.path.dirname(kept), prefix=".kept.", suffix=".part")
@@ -391,7 +392,7 @@ def _keep_filtered(work, settings):
                 os.unlink(temporary)
             raise
     elif work.filtered is not None:
-        kept = _kept_path(settings.keep_filtered, work.job.name)
+        kept = kept_filtered_path(settings, work.job)
         os.makedirs(os.path.dirname(kept), exist_ok=True)
         write_image(kept, work.filtered)
 

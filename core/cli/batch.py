@@ -134,6 +134,8 @@ class _Progress:
 def run(args):
     """Run ``aarecovery batch`` with parsed arguments; return the exit status."""
     from ..batch import ImageResult, check_report_path, make_settings, run_jobs, summary, write_report
+    from ..batch.destinations import check_batch_destinations
+    from ..batch.jobs import source_folder
     from ..batch.storage import is_url
 
     if args.workers is not None and args.workers < 1:
@@ -150,6 +152,10 @@ def run(args):
         blend_space=args.blend_space, tile_size=args.tile_size, mode="paper" if args.paper else "safe",
         max_bytes=None if args.max_image_memory is None else args.max_image_memory * 1e9, **_filter_options(args))
     jobs, unmatched = _jobs(args, settings.filter is not None)
+    # Every destination before anything is read, filtered or written.
+    check_batch_destinations(jobs, settings, report=args.report,
+                             sources=[source_folder(source) for source in (args.originals, args.filtered)
+                                      if source is not None and not is_url(source)])
     missing = [ImageResult(os.path.relpath(path, args.originals) if os.path.isdir(args.originals) else path,
                            status="failed", error=f"no filtered image matches {path}") for path in unmatched]
     if not args.dask and not is_url(args.output):

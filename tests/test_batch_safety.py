@@ -1,0 +1,114 @@
+"""``aarecovery batch`` and ``recover_many`` never lose a file: every destination (results,
+kept filtered images, maps, the report) is checked against the inputs and against each other,
+and every folder for writability, before any image is read or written."""
+
+import os
+import shutil
+
+import numpy as np
+import pytest
+
+import aarecovery
+from aarecovery import read_image, write_image
+from aarecovery.cli import main
+from scenes import shapes
+from test_cli_safety import one_line_error, read_only_folder  # noqa: F401 (a fixture)
+
+
+def run_batch(capsys, *args):
+    status = main(["batch", *map(str, args)])
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def write_originals(folder, names=("a.png", "b.png"), size=40):
+    os.makedirs(folder, exist_ok=True)
+    for index, name in enumerate(names):
+        write_image(folder / name, shapes(size, seed=index))
+
+
+def snapshot(folder):
+    """Every file under `folder`, with its bytes."""
+    return {path.relative_to(folder): path.read_bytes() for path in sorted(folder.rglob("*")) if path.is_file()}
+
+
+def copy_command():
+    return f"{shutil.which('cp')} {{in}} {{out}}"
+
+
+# --- item 1: a destination that would write over an input or over another destination ---------------------
+
+@pytest.mark.parametrize("maker", ["--filter", "--filter-cmd"])
+def test_keeping_filtered_images_in_the_originals_folder_is_refused(tmp_path, capsys, backend, maker):
+    write_originals(tmp_path / "o")
+    before = snapshot(tmp_path / "o")
+    making = ["--filter", "threshold"] if maker == "--filter" else ["--filter-cmd", copy_command()]
+    status, out, err = run_batch(capsys, tmp_path / "o", "-o", tmp_path / "r", "--backend", backend,
+                                 "--keep-filtered", tmp_path / "o", *making)
+    line = one_line_error(err)
+    assert status == 1 and "keep-filtered" in line and str(tmp_path / "o") in line
+    assert snapshot(tmp_path / "o") == before
+    assert not (tmp_path / "r").exists()
+
+
+def test_keeping_filtered_images_in_the_output_folder_is_refused(tmp_path, capsys):
+    write_originals(tmp_path / "o")
+    status, out, err = run_batch(capsys, tmp_path / "o", "-o", tmp_path / "r", "--backend", "numpy",
+                                 "--keep-filtered", tmp_path / "r", "--filter", "threshold")
+    line = one_line_error(err)
+    assert status == 1 and "output folder" in line
+    assert not (tmp_path / "r").exists()
+
+
+def test_keeping_filtered_images_under_a_glob_of_originals_is_refused(tmp_path, capsys):
+    write_originals(tmp_path / "scans")
+    before = snapshot(tmp_path / "scans")
+    status, out, err = run_batch(capsys, tmp_path / "scans" / "*.png", "-o", tmp_path / "r", "--backend", "numpy",
+                                 "--keep-filtered", tmp_path / "scans", "--filter-cmd", copy_command())
+    assert status == 1 and "keep-filtered" in one_line_error(err)
+    assert snapshot(tmp_path / "scans") == before
+
+
+@pytest.mark.parametrize("where", ["o", "f", "r"])
+def test_maps_over_an_input_folder_or_the_output_folder_are_refused(tmp_path, capsys, backend, where):
+    write_originals(tmp_path / "o")
+    write_originals(tmp_path / "f")
+    before = snapshot(tmp_path)
+    status, out, err = run_batch(capsys, tmp_path / "o", tmp_path / "f", "-o", tmp_path / "r", "--backend", backend,
+                                 "--maps", tmp_path / where)
+    assert status == 1 and "maps" in one_line_error(err)
+    assert snapshot(tmp_path) == before
+
+
+def test_results_over_the_originals_of_a_folder_pair_are_refused_before_any_work(tmp_path, capsys):
+    write_originals(tmp_path / "o")
+    write_originals(tmp_path / "f", names=("a.png", "b.png"))
+    before = snapshot(tmp_path)
+    status, out, err = run_batch(capsys, tmp_path / "o", tmp_path / "f", "-o", tmp_path / "o", "--backend", "numpy")
+    line = one_line_error(err)
+    assert status == 1 and "would replace the original image" in line and "--overwrite" in line
+    assert snapshot(tmp_path) == before
+
+
+def test_two_results_with_one_name_are_refused(tmp_path, capsys):
+    write_originals(tmp_path / "o", names=("a.png", "a.tif"))
+    status, out, err = run_batch(capsys, tmp_path / "o", "-o", tmp_path / "r", "--backend", "numpy", "--filter",
+                                 "threshold", "--format", "png")
+    line = one_line_error(err)
+    assert status == 1 and "a.png" in line and "both" in line
+    assert not (tmp_path / "r").exists()
+
+
+def test_recover_many_refuses_kept_filtered_images_over_the_originals(tmp_path, backend):
+    write_originals(tmp_path / "o")
+    before = snapshot(tmp_path / "o")
+    originals = [str(tmp_path / "o" / name) for name in ("a.png", "b.png")]
+    for keep in (tmp_path / "o", tmp_path / "r"):
+        with pytest.raises(aarecovery.InputError, match="keep-filtered"):
+            aarecovery.recover_many(originals, tmp_path / "r", filter="threshold", keep_filtered=keep,
+                                    backend=backend)
+    with pytest.raises(aarecovery.InputError, match="maps"):
+        aarecovery.recover_many([(originals[0], originals[1])], tmp_path / "r", maps=tmp_path / "o",
+                                backend=backend)
+    assert snapshot(tmp_path / "o") == before
+    assert not (tmp_path / "r").exists()
