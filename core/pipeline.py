@@ -201,22 +201,25 @@ def recover_tiles(engine, read, plan, pieces, layout, *, linear=False, maps=Fals
     maps : RecoveryMaps or None
         The maps on `inner`, with ``maps=True``.
     """
-    pending = None
-    for inner, outer in pieces:
-        original, filtered = read(outer)
-        engine.set_images(original, filtered, linear=linear, blend_space=plan.blend_space)
-        engine.run(plan, maps=maps, wait=False)
-        crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
-        tile_maps = None
-        if maps:
-            whole = engine.maps()
-            tile_maps = RecoveryMaps(*(getattr(whole, name)[crop] for name in RecoveryMaps.NAMES))
-        started = engine.start_result(crop)
+    # The engine's lock for the whole pair: a thread sharing the engine waits, instead of
+    # loading its tiles between this one's load and readback.
+    with engine.lock:
+        pending = None
+        for inner, outer in pieces:
+            original, filtered = read(outer)
+            engine.set_images(original, filtered, linear=linear, blend_space=plan.blend_space)
+            engine.run(plan, maps=maps, wait=False)
+            crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
+            tile_maps = None
+            if maps:
+                whole = engine.maps()
+                tile_maps = RecoveryMaps(*(getattr(whole, name)[crop] for name in RecoveryMaps.NAMES))
+            started = engine.start_result(crop)
+            if pending is not None:
+                yield _finished(pending, layout, into)
+            pending = (inner, started, tile_maps)
         if pending is not None:
             yield _finished(pending, layout, into)
-        pending = (inner, started, tile_maps)
-    if pending is not None:
-        yield _finished(pending, layout, into)
 
 
 def _finished(pending, layout, into):
