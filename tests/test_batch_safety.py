@@ -112,3 +112,75 @@ def test_recover_many_refuses_kept_filtered_images_over_the_originals(tmp_path, 
                                 backend=backend)
     assert snapshot(tmp_path / "o") == before
     assert not (tmp_path / "r").exists()
+
+
+# --- item 4: every output written or the image is not done; interruptions and resumes reported -----------
+
+def write_pairs(folder, count=3, size=40):
+    for sub in ("o", "f"):
+        os.makedirs(folder / sub, exist_ok=True)
+    for index in range(count):
+        original = shapes(size, seed=index)
+        write_image(folder / "o" / f"p{index}.png", original)
+        write_image(folder / "f" / f"p{index}.png", np.where(original > 127, 255, 0).astype(np.uint8))
+
+
+def test_a_maps_folder_that_cannot_be_written_stops_the_batch_before_any_work(tmp_path, capsys, backend,
+                                                                               read_only_folder):
+    write_pairs(tmp_path)
+    status, out, err = run_batch(capsys, tmp_path / "o", tmp_path / "f", "-o", tmp_path / "r", "--backend", backend,
+                                 "--maps", read_only_folder / "maps")
+    line = one_line_error(err)
+    assert status == 1 and str(read_only_folder) in line
+    assert not (tmp_path / "r").exists()
+
+
+def test_an_image_whose_maps_fail_is_not_written_and_is_redone_by_the_next_run(tmp_path, capsys, backend):
+    write_pairs(tmp_path)
+    os.makedirs(tmp_path / "maps")
+    (tmp_path / "maps" / "p1").write_text("a file where p1's maps folder goes")
+    args = [tmp_path / "o", tmp_path / "f", "-o", tmp_path / "r", "--backend", backend, "--maps", tmp_path / "maps"]
+    status, out, err = run_batch(capsys, *args)
+    assert status == 1 and "failed: p1.png" in err
+    assert sorted(os.listdir(tmp_path / "r")) == ["p0.png", "p2.png"]
+    os.unlink(tmp_path / "maps" / "p1")
+    status, out, err = run_batch(capsys, *args)
+    assert status == 0 and "1 recovered" in out and "2 up to date" in out
+    assert sorted(os.listdir(tmp_path / "maps" / "p1")) == ["alpha.png", "beta.png", "edge_strength.png",
+                                                            "residual.png"]
+    # A map removed since: the image is not up to date.
+    os.unlink(tmp_path / "maps" / "p0" / "beta.png")
+    status, out, err = run_batch(capsys, *args)
+    assert status == 0 and "1 recovered" in out and (tmp_path / "maps" / "p0" / "beta.png").exists()
+
+
+def test_an_interrupted_batch_reports_every_image_it_wrote(tmp_path):
+    write_pairs(tmp_path, count=6, size=160)
+    reported = []
+
+    def progress(result, done, total):
+        reported.append(result)
+        if len(reported) == 1:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        aarecovery.recover_many([(tmp_path / "o" / f"p{i}.png", tmp_path / "f" / f"p{i}.png") for i in range(6)],
+                                tmp_path / "r", backend="numpy", workers=1, progress=progress)
+    written = sorted(name for name in os.listdir(tmp_path / "r") if not name.startswith("."))
+    assert sorted(result.name for result in reported if result.status == "done") == written
+
+
+@pytest.mark.parametrize("extension", [".csv", ".json"])
+def test_a_resumed_batch_reports_the_plan_of_the_images_it_skipped(tmp_path, capsys, extension):
+    write_pairs(tmp_path)
+    report = tmp_path / f"report{extension}"
+    args = [tmp_path / "o", tmp_path / "f", "-o", tmp_path / "r", "--backend", "numpy", "--report", report]
+    assert run_batch(capsys, *args)[0] == 0
+    first = aarecovery.batch.read_report(report)
+    os.unlink(tmp_path / "r" / "p1.png")
+    assert run_batch(capsys, *args)[0] == 0
+    second = aarecovery.batch.read_report(report)
+    assert [row["status"] for row in second] == ["skipped", "done", "skipped"]
+    for before, after in zip(first, second):
+        for name in ("width", "height", "dtype", "mode", "blend_space", "strength", "reason", "backend", "streamed"):
+            assert after[name] == before[name] and after[name] not in ("", None), name

@@ -12,10 +12,8 @@ import os
 
 from ..errors import InputError
 from ..io.destinations import check_writable_folders, file_identity
-from ..io.maps import map_paths
 from . import storage
-from .jobs import output_name
-from .work import kept_filtered_path, maps_folder
+from .work import destinations
 
 __all__ = ["check_batch_destinations"]
 
@@ -33,19 +31,6 @@ def _real(folder):
 def _inside(path, folder):
     """True when the real `path` is `folder` or below it (both real paths)."""
     return path == folder or path.startswith(folder.rstrip(os.sep) + os.sep)
-
-
-def _destinations(job, settings):
-    """``(role, path)`` of every file the batch writes for `job` (local ones)."""
-    if settings.output is None:
-        return
-    if _is_local(settings.output):
-        yield "result", storage.join(settings.output, output_name(job.name, settings.format))
-    if settings.keep_filtered is not None and job.filtered is None:
-        yield "kept filtered image", kept_filtered_path(settings, job)
-    if settings.maps is not None:
-        for path in map_paths(maps_folder(settings, job)).values():
-            yield "map", path
 
 
 def check_batch_destinations(jobs, settings, *, report=None, sources=()):
@@ -75,7 +60,9 @@ def check_batch_destinations(jobs, settings, *, report=None, sources=()):
     _check_folders(settings, [_real(path) for _, path in inputs.values()], [_real(source) for source in sources])
     written = {}
     for job in jobs:
-        for role, path in _destinations(job, settings):
+        for role, path in destinations(job, settings):
+            if not _is_local(path):
+                continue
             _check_one(role, path, inputs, written, settings.overwrite)
     if report is not None:
         _check_one("report", report, inputs, written, False)

@@ -19,8 +19,8 @@ from dataclasses import dataclass, field, fields
 from .. import stream
 from ..contract import check_same_size, check_values, layout_of
 from ..errors import InputError
-from ..io import check_output_path, read_image, write_image
-from ..io.maps import write_maps
+from ..io import check_output_path, read_image, write_image, write_images
+from ..io.maps import map_paths, maps_as_images
 from ..params import Parameters
 from ..pipeline import recover
 from ..plan import make_plan
@@ -29,7 +29,8 @@ from . import storage
 from .filtering import BuiltinFilter, FilterCommand
 from .jobs import output_name
 
-__all__ = ["Settings", "ImageResult", "Work", "prepare", "compute", "store", "run_one", "fail", "REPORT_FIELDS"]
+__all__ = ["Settings", "ImageResult", "Work", "prepare", "compute", "store", "run_one", "fail", "REPORT_FIELDS",
+           "destinations", "kept_filtered_path", "maps_folder"]
 
 
 @dataclass(frozen=True)
@@ -204,13 +205,15 @@ def _is_path(value):
     return isinstance(value, (str, os.PathLike))
 
 
-def _up_to_date(output, inputs):
-    """The result exists (so it is complete: every write is atomic) and is newer than its inputs."""
+def _up_to_date(job, settings, output, inputs):
+    """The result exists (so it is complete: every write is atomic) and is newer than its
+    inputs, and every other file of the image (kept F, maps) exists."""
     made = storage.modified(output)
     if made is None:
         return False
     stamps = [storage.modified(path) for path in inputs]
-    return all(stamp is not None and stamp <= made for stamp in stamps)
+    return all(stamp is not None and stamp <= made for stamp in stamps) and \
+        all(storage.exists(path) for role, path in destinations(job, settings) if role != "result")
 
 
 def remove_stale_parts(output, before):
@@ -245,6 +248,19 @@ def maps_folder(settings, job):
     return _kept_path(settings.maps, job.name, "")
 
 
+def destinations(job, settings):
+    """``(role, path)`` of every file the batch writes for `job`: its result, the filtered
+    image it keeps, its maps (none without an output folder)."""
+    if settings.output is None:
+        return
+    yield "result", storage.join(settings.output, output_name(job.name, settings.format))
+    if settings.keep_filtered is not None and job.filtered is None:
+        yield "kept filtered image", kept_filtered_path(settings, job)
+    if settings.maps is not None:
+        for path in map_paths(maps_folder(settings, job)).values():
+            yield "map", path
+
+
 def prepare(job, settings, capabilities, started, planner=make_plan):
     """Stage 1: skip, read, filter, plan. Returns a :class:`Work`, failed or skipped ones included.
 
@@ -276,7 +292,7 @@ def _prepare(work, settings, capabilities, started, planner):
     if settings.output is not None:
         work.output = work.target = storage.join(settings.output, output_name(job.name, settings.format))
         remove_stale_parts(work.output, started)
-        if not settings.force and inputs and _up_to_date(work.output, inputs):
+        if not settings.force and inputs and _up_to_date(job, settings, work.output, inputs):
             result.status, result.output = "skipped", work.output
             return
         if storage.is_url(work.output):
@@ -355,17 +371,20 @@ def store(work, settings):
         return result
     try:
         with _Timed(result):
-            if work.output is not None and work.pair is None:
-                write_image(work.target, work.recovered)
-            elif work.output is None:
+            if work.output is None:
                 result.image = work.recovered
-            if work.target != work.output:
-                storage.publish(work.target, work.output)
-            _keep_filtered(work, settings)
-            if settings.maps is not None and work.maps is not None:
-                folder = maps_folder(settings, work.job)
-                os.makedirs(folder, exist_ok=True)
-                write_maps(folder, work.maps)
+            else:
+                _keep_filtered(work, settings)
+                images = {} if work.pair is not None else {work.target: work.recovered}
+                if settings.maps is not None and work.maps is not None:
+                    folder = maps_folder(settings, work.job)
+                    os.makedirs(folder, exist_ok=True)
+                    images.update(maps_as_images(folder, work.maps))
+                # The result last and with its maps, all or none: a result that exists means
+                # that every file of the image was written (a re-run skips it).
+                write_images(images)
+                if work.target != work.output:
+                    storage.publish(work.target, work.output)
         result.output = work.output
         result.status = "done"
     except Exception as error:
