@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, fields
 from .. import stream
 from ..contract import check_same_size, check_values, layout_of
 from ..errors import InputError
-from ..io import check_output_path, read_image, write_image, write_images
+from ..io import check_output_path, read_image, warn_if_orientations_differ, write_image, write_images
 from ..io.maps import map_paths, maps_as_images
 from ..params import Parameters
 from ..pipeline import recover
@@ -336,6 +336,8 @@ def _prepare(work, settings, capabilities, started, planner):
         work.original, work.filtered = original, filtered
         work.plan = planner(*array_sample(original, filtered), settings.parameters, mode=settings.mode,
                             linear=settings.linear, blend_space=settings.blend_space)
+    if original_path and filtered_path:
+        warn_if_orientations_differ(original_path, filtered_path, job.name)
     plan = work.plan
     result.mode, result.blend_space, result.strength, result.reason = (plan.mode, plan.blend_space, plan.strength,
                                                                       plan.reason)

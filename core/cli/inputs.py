@@ -2,8 +2,7 @@
 
 from ..contract import check_same_size, layout_of
 from ..errors import InputError
-from ..io import DEFAULT_MAX_BYTES, orientation_tag, read_image
-from ..io.orientation import ORIENTATION_NAMES
+from ..io import DEFAULT_MAX_BYTES, describe_orientations, read_image, warn_if_orientations_differ
 
 __all__ = ["add_image_memory_option", "read_input", "check_pair_size"]
 
@@ -33,7 +32,8 @@ def read_input(path, args):
 
 
 def check_pair_size(original, filtered, paths):
-    """Refuse a pair of different sizes; say so when the files declare different orientations.
+    """Refuse a pair of different sizes, saying so when the files declare different
+    orientations; warn when the sizes match but the orientations differ.
 
     Every reader turns pixels upright by the orientation the file declares; a program that
     dropped the tag without turning the pixels leaves a pair that no longer matches.
@@ -41,11 +41,10 @@ def check_pair_size(original, filtered, paths):
     try:
         check_same_size(layout_of(original, "original"), layout_of(filtered, "filtered"))
     except InputError as error:
-        tags = [orientation_tag(path) for path in paths]
-        if tags[0] == tags[1]:
+        described = describe_orientations(paths)
+        if described is None:
             raise
-        described = " but ".join(f"{role} is tagged orientation {tag} ({ORIENTATION_NAMES[tag]} for display)"
-                                 for role, tag in zip(("ORIGINAL", "FILTERED"), tags))
         raise InputError(f"{error}. The files' orientation tags differ: {described}; each is shown upright "
                          "as tagged, so the program that wrote one of them may have dropped or changed the "
                          "tag without turning its pixels") from None
+    warn_if_orientations_differ(*paths)

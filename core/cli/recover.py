@@ -182,10 +182,14 @@ def summary_line(plan, original=None, filtered=None, recovered=None):
 
 def _open_streamed(args, params, engine):
     """A pair of TIFFs that can be read in pieces and is larger than a tile, else None."""
+    from ..io import warn_if_orientations_differ
     from ..stream import open_pair, resolve_tile
 
-    return open_pair(args.original, args.filtered, resolve_tile(engine.capabilities, args.tile_size),
+    pair = open_pair(args.original, args.filtered, resolve_tile(engine.capabilities, args.tile_size),
                      params.iterations)
+    if pair is not None:
+        warn_if_orientations_differ(args.original, args.filtered)
+    return pair
 
 
 def _recover_streamed(args, params, pair, engine):
