@@ -4,6 +4,7 @@ and every folder for writability, before any image is read or written."""
 
 import os
 import shutil
+import sys
 
 import numpy as np
 import pytest
@@ -184,3 +185,34 @@ def test_a_resumed_batch_reports_the_plan_of_the_images_it_skipped(tmp_path, cap
     for before, after in zip(first, second):
         for name in ("width", "height", "dtype", "mode", "blend_space", "strength", "reason", "backend", "streamed"):
             assert after[name] == before[name] and after[name] not in ("", None), name
+
+
+# --- item 6: the filtered images a batch makes are lossless ---------------------------------------------------
+
+THRESHOLD_SCRIPT = ("import sys; from PIL import Image; "
+                    "Image.open(sys.argv[1]).convert('L').point(lambda v: 255 if v > 127 else 0).save(sys.argv[2])")
+
+
+@pytest.mark.parametrize("maker", ["--filter", "--filter-cmd"])
+def test_filtered_images_of_a_jpeg_original_are_made_and_kept_lossless(tmp_path, capsys, backend, maker):
+    os.makedirs(tmp_path / "o")
+    original = shapes(64, seed=3)
+    write_image(tmp_path / "o" / "x.jpg", original)
+    making = (["--filter", "threshold"] if maker == "--filter" else
+              ["--filter-cmd", f"{sys.executable} -c \"{THRESHOLD_SCRIPT}\" {{in}} {{out}}"])
+    status, out, err = run_batch(capsys, tmp_path / "o", "-o", tmp_path / "r", "--backend", backend,
+                                 "--keep-filtered", tmp_path / "kept", "--format", "png", *making)
+    assert status == 0, err
+    assert sorted(os.listdir(tmp_path / "kept")) == ["x.png"]
+    kept = read_image(tmp_path / "kept" / "x.png")
+    assert set(np.unique(kept)) <= {0, 255}
+    # The batch recovered with that lossless F.
+    np.testing.assert_array_equal(read_image(tmp_path / "r" / "x.png"),
+                                  aarecovery.recover(read_image(tmp_path / "o" / "x.jpg"), kept, backend=backend))
+
+
+def test_filter_command_help_says_the_filtered_image_is_lossless(capsys):
+    with pytest.raises(SystemExit):
+        main(["batch", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "lossless" in text and "PNG" in text

@@ -6,8 +6,8 @@ or ``gegl {in} -o {out} -- gegl:levels in-high=0.6``. It is split into words fir
 shell quoting rules, no shell runs it), then ``{in}`` and ``{out}`` are replaced inside
 each word, so paths with spaces need no quoting. The command reads a temporary copy of
 the original, so a tool that writes into its input cannot touch it, and writes a file in
-the same temporary folder, in the original's format unless ``{out}`` is given an
-extension (``{out}.png``); a non-zero exit status, or no output file, fails that image with
+the same temporary folder, in the original's format when it is lossless, else PNG, unless
+``{out}`` is given an extension (``{out}.jpg``); a non-zero exit status, or no output file, fails that image with
 the tool's own message.
 """
 
@@ -21,6 +21,7 @@ import threading
 from dataclasses import dataclass, field
 
 from ..errors import InputError
+from ..io.formats import lossless_extension
 
 __all__ = ["BuiltinFilter", "FilterCommand", "FilterFailed"]
 
@@ -102,8 +103,12 @@ class FilterCommand:
         return chosen.group(1) if chosen else None
 
     def output_extension(self, original_path):
-        """The extension of the file the command writes for `original_path` (``".png"``)."""
-        return self._chosen_extension() or os.path.splitext(original_path)[1]
+        """The extension of the file the command writes for `original_path`: the template's
+        (``{out}.jpg``), else the original's when lossless, else ``.png``.
+
+        A JPEG F would add its own artefacts to the filter's result (a threshold came back
+        with 52 grey levels), and F's values are what the recovery fits."""
+        return self._chosen_extension() or lossless_extension(os.path.splitext(original_path)[1])
 
     def run(self, original_path, folder):
         """Run the command on a copy of `original_path` inside `folder`; return the output's path.

@@ -20,6 +20,7 @@ from .. import stream
 from ..contract import check_same_size, check_values, layout_of
 from ..errors import InputError
 from ..io import check_output_path, read_image, warn_if_orientations_differ, write_image, write_images
+from ..io.formats import lossless_extension
 from ..io.maps import map_paths, maps_as_images
 from ..params import Parameters
 from ..pipeline import recover
@@ -240,7 +241,7 @@ def kept_filtered_path(settings, job):
     if isinstance(settings.filter, FilterCommand):
         original = os.fspath(job.original) if _is_path(job.original) else job.name
         return _kept_path(settings.keep_filtered, job.name, settings.filter.output_extension(original))
-    return _kept_path(settings.keep_filtered, job.name)
+    return _kept_path(settings.keep_filtered, job.name, lossless_extension(os.path.splitext(job.name)[1]))
 
 
 def maps_folder(settings, job):

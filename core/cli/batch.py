@@ -33,9 +33,11 @@ examples:
   aarecovery batch originals/ filtered/ -o repaired/ --dask tcp://scheduler:8786
 
 filter commands: the template is split into words like a shell would (no shell runs it);
-{in} is a temporary copy of the original, {out} the file the tool must write, in the
-original's format unless written with an extension ({out}.png). ImageMagick 6 is
-'convert', ImageMagick 7 'magick'. For pipes or redirection run a shell: 'sh -c "..."'.
+{in} is a temporary copy of the original, {out} the file the tool must write: lossless, in
+the original's format when that is lossless (PNG, TIFF, ...), else PNG (for a JPEG, WebP or
+GIF original), unless written with an extension ({out}.jpg). A filtered image the batch
+keeps (--keep-filtered) is lossless the same way. ImageMagick 6 is 'convert', ImageMagick 7
+'magick'. For pipes or redirection run a shell: 'sh -c "..."'.
 """
 
 
