@@ -21,7 +21,7 @@ from .plan.order import check_order
 from .sample import array_sample
 from .tiling import DEFAULT_TILES, check_tile_size, halo_for, tiles
 
-__all__ = ["recover", "recover_tiles"]
+__all__ = ["recover", "recover_tiles", "tile_side"]
 
 
 def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
@@ -136,7 +136,7 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     own_engine = engine is None
     if own_engine:
         engine = Engine(backend, gl_path=gl_path)
-    tile = min(engine.capabilities.max_tile, tile_size or engine.capabilities.default_tile)
+    tile = tile_side(engine.capabilities, tile_size)
     try:
         return _recover_in_tiles(original, filtered, f_layout, plan, engine, tile, linear, return_maps)
     except MemoryError as error:
@@ -144,6 +144,11 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     finally:
         if own_engine:
             engine.release()
+
+
+def tile_side(capabilities, tile_size=None):
+    """The tile side :func:`recover` uses on a backend with these capabilities."""
+    return min(capabilities.max_tile, tile_size or capabilities.default_tile)
 
 
 def _out_of_memory(error, o_layout, f_layout, backend, tile, return_maps):

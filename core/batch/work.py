@@ -23,7 +23,8 @@ from ..io import check_output_path, read_image, warn_if_orientations_differ, wri
 from ..io.formats import lossless_extension
 from ..io.maps import map_paths, maps_as_images
 from ..params import Parameters
-from ..pipeline import recover
+from ..memory import check_pair_files
+from ..pipeline import recover, tile_side
 from ..plan import make_plan
 from ..sample import array_sample
 from . import storage
@@ -311,15 +312,19 @@ def _prepare(work, settings, capabilities, started, planner):
     if streamable:
         work.pair = stream.open_pair(original_path, filtered_path,
                                      stream.resolve_tile(capabilities, settings.tile_size),
-                                     settings.parameters.iterations)
+                                     settings.parameters.iterations, max_bytes=settings.max_bytes)
     if work.pair is not None:
         result.streamed = True
         result.height, result.width = work.pair.height, work.pair.width
         result.dtype = str(work.pair.result_dtype)
         check_output_path(work.target, work.pair.result_shape)
+        stream.check_room(work.pair, work.target)
         work.plan = stream.plan_pair(work.pair, settings.parameters, mode=settings.mode, linear=settings.linear,
                                      blend_space=settings.blend_space, planner=planner)
     else:
+        if original_path:
+            check_pair_files(original_path, filtered_path, tile_side(capabilities, settings.tile_size),
+                             maps=settings.maps is not None, max_bytes=settings.max_bytes)
         original = read_image(original_path, max_bytes=settings.max_bytes) if original_path else job.original
         if filtered_path:
             filtered = read_image(filtered_path, max_bytes=settings.max_bytes)

@@ -6,7 +6,7 @@ import sys
 import time
 
 from ..errors import InputError
-from .inputs import add_image_memory_option
+from .inputs import add_image_memory_option, memory_limit
 from .recover import add_recovery_options
 
 __all__ = ["register", "run"]
@@ -152,7 +152,7 @@ def run(args):
         overwrite=args.overwrite, sigma_d=args.sigma_d, sigma_e=args.sigma_e, iterations=args.iterations,
         strength=args.strength, gl_path=args.gl_path, backend=args.backend, linear=args.linear,
         blend_space=args.blend_space, tile_size=args.tile_size, mode="paper" if args.paper else "safe",
-        max_bytes=None if args.max_image_memory is None else args.max_image_memory * 1e9, **_filter_options(args))
+        max_bytes=memory_limit(args), **_filter_options(args))
     jobs, unmatched = _jobs(args, settings.filter is not None)
     # Every destination before anything is read, filtered or written.
     check_batch_destinations(jobs, settings, report=args.report,

@@ -4,7 +4,7 @@ from ..contract import check_same_size, layout_of
 from ..errors import InputError
 from ..io import DEFAULT_MAX_BYTES, describe_orientations, read_image, warn_if_orientations_differ
 
-__all__ = ["add_image_memory_option", "read_input", "check_pair_size"]
+__all__ = ["add_image_memory_option", "memory_limit", "read_input", "check_pair_size"]
 
 
 def _gigabytes(text):
@@ -20,15 +20,21 @@ def _gigabytes(text):
 def add_image_memory_option(parser):
     """``--max-image-memory GB``: raise (or lower) the decompression-bomb limit of every read."""
     parser.add_argument("--max-image-memory", type=_gigabytes, metavar="GB",
-                        help="largest decoded size of one image, checked from the file's header before "
-                             f"decoding (default {DEFAULT_MAX_BYTES / 1e9:g} GB; larger files are refused as "
-                             "possible decompression bombs)")
+                        help="largest decoded size of one image, and of a recovery's peak (O, F, R and a "
+                             "tile), checked from the files' headers before decoding (default "
+                             f"{DEFAULT_MAX_BYTES / 1e9:g} GB; larger files are refused as possible decompression "
+                             "bombs)")
+
+
+def memory_limit(args):
+    """The command's ``--max-image-memory`` in bytes, or None for the default."""
+    limit = getattr(args, "max_image_memory", None)
+    return None if limit is None else limit * 1e9
 
 
 def read_input(path, args):
     """:func:`aarecovery.read_image` with the command's ``--max-image-memory``."""
-    limit = getattr(args, "max_image_memory", None)
-    return read_image(path, max_bytes=None if limit is None else limit * 1e9)
+    return read_image(path, max_bytes=memory_limit(args))
 
 
 def check_pair_size(original, filtered, paths):

@@ -13,10 +13,10 @@ import numpy as np
 
 from ..errors import InputError, NotEnoughMemory, OrientationWarning
 from .formats import NPY_DTYPES, READ_FORMATS, import_codec
-from .limits import check_decoded_size
+from .limits import DECLARED_ONLY, Declared, check_decoded_size
 from .orientation import ORIENTATION_NAMES, apply_orientation, png_header, tiff_orientation
 
-__all__ = ["read_image", "orientation_tag", "describe_orientations", "warn_if_orientations_differ"]
+__all__ = ["read_image", "declared_image", "orientation_tag", "describe_orientations", "warn_if_orientations_differ"]
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 _TIFF_SIGNATURES = (b"II*\x00", b"MM\x00*", b"II+\x00", b"MM\x00+")
@@ -101,6 +101,27 @@ def orientation_tag(path):
             return int(image.getexif().get(0x0112, 1))
     except (InputError, OSError, ValueError, TypeError):
         return 1
+
+
+def declared_image(path):
+    """The shape and dtype :func:`read_image` would decode `path` to, from its header alone.
+
+    Returns
+    -------
+    shape : tuple of int
+    dtype : numpy.dtype
+
+    Raises
+    ------
+    InputError
+        As :func:`read_image` does for a file it cannot read.
+    """
+    try:
+        # Each reader reports its header's figures to check_decoded_size before decoding.
+        image = read_image(path, max_bytes=DECLARED_ONLY)
+    except Declared as declared:
+        return declared.shape, declared.dtype
+    return image.shape, image.dtype  # a reader that checks no size (an .npy of another rank)
 
 
 def describe_orientations(paths):
