@@ -27,5 +27,5 @@ from .pipeline import recover
 from .plan.order import check_order
 
 __all__ = ["recover", "recover_many", "check_order", "summarize_recovery", "Engine", "Plan", "RecoveryMaps",
-           "RecoverySummary", "InputError", "GLUnavailable", "OrderWarning", "OrientationWarning", "read_image", "write_image", "filters",
-           "PARAMETERS", "BACKENDS", "GL_PATHS", "MODES", "BLEND_SPACES", "__version__"]
+           "RecoverySummary", "InputError", "GLUnavailable", "OrderWarning", "OrientationWarning", "read_image",
+           "write_image", "filters", "PARAMETERS", "BACKENDS", "GL_PATHS", "MODES", "BLEND_SPACES", "__version__"]

@@ -27,7 +27,8 @@ from .plan import make_plan
 from .sample import analysis_sample
 from .tiling import aligned_tiles, halo_for
 
-__all__ = ["open_pair", "check_room", "resolve_tile", "stream_tile", "plan_pair", "recover_pair", "StreamedPair", "STREAM_TILE"]
+__all__ = ["open_pair", "check_room", "resolve_tile", "stream_tile", "plan_pair", "recover_pair", "StreamedPair",
+           "STREAM_TILE"]
 
 #: The largest tile a streamed pair is recovered in when no tile size is given (the NumPy
 #: backend's own 512 is smaller). Measured on 2 cores with GL on llvmpipe, an 8192 x 8192
