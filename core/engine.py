@@ -1,5 +1,7 @@
 """The reusable recovery engine: one backend, one pair of images, plans that change."""
 
+import functools
+import threading
 import time
 
 from .backends import make_backend
@@ -11,6 +13,15 @@ from .plan import analyse_pair, make_plan
 from .sample import array_sample
 
 __all__ = ["Engine", "RecoveryMaps"]
+
+
+def _exclusive(method):
+    """Run a method holding the engine's lock: one thread at a time loads, runs or reads."""
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        with self.lock:
+            return method(self, *args, **kwargs)
+    return wrapper
 
 
 class Engine:
@@ -32,6 +43,19 @@ class Engine:
         How the GL backend runs its passes: ``"auto"`` chooses by the context's capabilities
         and a measured rule; ``"compute"`` needs OpenGL 4.3. Only ``"auto"`` with NumPy.
 
+    Notes
+    -----
+    An engine may be shared by threads. Each call holds :attr:`lock`, and
+    :func:`aarecovery.recover` (``engine=``) holds it for the whole pair, so concurrent
+    ``recover`` calls on one engine run one after the other and each gets its own result
+    (on GL the engine's own context is made current in the calling thread for each call,
+    which EGL allows once no other thread holds it). A pair loaded with :meth:`set_images`
+    belongs to the thread that loaded it: :meth:`compute`, :meth:`result` and the other
+    calls on it from another thread are refused with :class:`InputError`, as they would
+    read another thread's pair; hold :attr:`lock` around ``set_images`` and ``recover`` to
+    share the engine that way, or make one engine per thread to run in parallel. A
+    borrowed `context` (a window's) is used only in the thread that owns it.
+
     Examples
     --------
     >>> engine = Engine(backend="numpy")
@@ -41,8 +65,20 @@ class Engine:
     """
 
     def __init__(self, backend="auto", *, context=None, gl_path="auto"):
+        #: threading.RLock: held by every call; hold it around :meth:`set_images` and what
+        #: follows to use one engine from several threads.
+        self.lock = threading.RLock()
         self._impl = make_backend(backend, context, gl_path)
+        if context is None and self.context is not None:
+            # A new context is current in the thread that made it, and a context current in
+            # one thread cannot be made current in another (EGL_BAD_ACCESS, which showed as a
+            # texture that could not be made). Leaving its scope once leaves it current in no
+            # thread; each call then makes it current in the calling thread (under the lock).
+            with self.context:
+                pass
         self._released = False
+        # The thread that loaded the pair: calls on it from others would read that thread's pair.
+        self._loader = None
         # None, or {"maps": bool} once a run finished on the loaded pair.
         self._computed = None
         self._layout = None
@@ -80,6 +116,7 @@ class Engine:
         """tuple of int: ``(width, height)`` of the loaded pair, or None."""
         return None if self._layout is None else (self._layout.width, self._layout.height)
 
+    @_exclusive
     def set_images(self, original, filtered, *, linear=False, blend_space=None):
         """Check and load an image pair (uploads it once for GL).
 
@@ -108,6 +145,7 @@ class Engine:
         if blend_space is not None:
             check_blend_space(blend_space)
         self._computed = None
+        self._loader = threading.get_ident()
         self._layout = f_layout
         self._pair = (original, o_layout, filtered, f_layout, bool(linear), blend_space)
         self._analysis = None
@@ -130,6 +168,10 @@ class Engine:
         self._require_unreleased()
         if self._layout is None:
             raise InputError("no images loaded: call set_images(original, filtered) first")
+        if self._loader != threading.get_ident():
+            raise InputError("the images in this engine were loaded by another thread, so this call would use "
+                             "that thread's pair: call set_images in this thread first (holding engine.lock "
+                             "around set_images and recover), or make one Engine per thread")
 
     def _require_computed(self, maps=False):
         self._require_images()
@@ -139,6 +181,7 @@ class Engine:
         if maps and not self._computed["maps"]:
             raise InputError("the last compute() kept no maps: call compute(maps=True) first")
 
+    @_exclusive
     def plan(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
              mode=DEFAULT_MODE, strength=STRENGTH.default):
         """The Plan that :meth:`compute` would run for the loaded pair (analysed once per pair).
@@ -155,6 +198,7 @@ class Engine:
         return make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space,
                          analysis=self._analysis)
 
+    @_exclusive
     def compute(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
                 maps=False, mode=DEFAULT_MODE, strength=STRENGTH.default):
         """Run the recovery and keep the result in the backend (on the GPU for GL).
@@ -177,6 +221,7 @@ class Engine:
         self.run(self.plan(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode, strength=strength),
                  maps=maps)
 
+    @_exclusive
     def run(self, plan, *, maps=False, wait=True):
         """Run a resolved :class:`Plan` on the loaded pair; the result stays in the backend.
 
@@ -198,6 +243,7 @@ class Engine:
         self._computed = {"maps": bool(maps)}
         self.last_plan = plan
 
+    @_exclusive
     def result(self):
         """Read the last result back in the filtered image's shape and dtype.
 
@@ -214,6 +260,7 @@ class Engine:
         self._require_computed()
         return from_rgba_float(self._impl.start_readback().wait(), self._layout)
 
+    @_exclusive
     def start_result(self, window=None):
         """Start reading the last result back, for a caller that overlaps tiles.
 
@@ -232,12 +279,14 @@ class Engine:
         self._require_computed()
         return self._impl.start_readback(window)
 
+    @_exclusive
     def recover(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
                 mode=DEFAULT_MODE, strength=STRENGTH.default):
         """Compute and return R: :meth:`compute` then :meth:`result`."""
         self.compute(sigma_d=sigma_d, sigma_e=sigma_e, iterations=iterations, mode=mode, strength=strength)
         return self.result()
 
+    @_exclusive
     def maps(self):
         """Return the intermediate maps of the last :meth:`compute` with ``maps=True``.
 
@@ -253,6 +302,7 @@ class Engine:
         self._require_computed(maps=True)
         return self._impl.read_maps()
 
+    @_exclusive
     def texture(self, name="result"):
         """GL only: a texture of the engine, in its (possibly borrowed) context, for display.
 
@@ -275,6 +325,7 @@ class Engine:
             self._require_computed(maps=True)
         return self._impl.texture(name)
 
+    @_exclusive
     def release(self):
         """Free textures and programs (and the context, if the engine made it); idempotent.
 

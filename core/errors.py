@@ -1,7 +1,7 @@
 """The exceptions users catch (bad input, not enough memory) and the warnings aarecovery gives."""
 
 __all__ = ["InputError", "NotEnoughMemory", "AarecoveryWarning", "BackendFallbackWarning", "OrderWarning",
-           "TileSizeWarning"]
+           "TileSizeWarning", "OrientationWarning"]
 
 
 class InputError(ValueError):
@@ -25,6 +25,14 @@ class OrderWarning(AarecoveryWarning):
     """ORIGINAL and FILTERED look swapped: the image given as filtered has the antialiased edges.
 
     ``aarecovery.plan.order`` decides it; the message is one line that says why.
+    """
+
+
+class OrientationWarning(AarecoveryWarning):
+    """ORIGINAL and FILTERED declare different orientations (EXIF / TIFF tags).
+
+    Each is turned upright as tagged; when a program dropped or changed the tag without
+    turning the pixels, a square pair still matches in size but is misaligned.
     """
 
 

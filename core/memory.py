@@ -20,10 +20,14 @@ on both backends (GL: ~110 bytes of textures, the readback and the driver's copi
 ~40 float32 planes); the process itself takes about 250 MB with a GL driver, 50 MB without.
 """
 
-from .errors import NotEnoughMemory
-from .io.limits import format_bytes
+import numpy as np
 
-__all__ = ["recovery_bytes", "not_enough_memory"]
+from .contract import layout_of
+from .errors import InputError, NotEnoughMemory
+from .io import check_decoded_size, declared_image
+from .io.limits import format_bytes, max_bytes_from, raise_the_limit
+
+__all__ = ["recovery_bytes", "not_enough_memory", "check_recovery_peak", "check_pair_files"]
 
 _TILE_BYTES_PER_PIXEL = 160
 _PROCESS_BYTES = {"gl": 250 * 10**6, "numpy": 50 * 10**6}
@@ -67,3 +71,50 @@ def not_enough_memory(o_layout, f_layout, backend, tile, maps=False, detail=""):
         f"{f' ({detail})' if detail else ''}: it needs about {format_bytes(total)} ({format_bytes(whole)} for the "
         f"whole images, {format_bytes(working)} for a {min(tile, max(f_layout.height, f_layout.width))}-pixel "
         f"tile); try {', or '.join(advice)}")
+
+
+def check_recovery_peak(original, filtered, tile, maps=False, max_bytes=None, name=None):
+    """Refuse a pair whose recovery would hold more than the image memory limit at its peak.
+
+    The limit (``--max-image-memory``, ``max_bytes``) bounds each decoded image, but a
+    recovery holds O, F and R whole and expands one tile to RGBA float planes (a 1.6 GB
+    40000 x 40000 grey pair peaked at 5 GB): this counts all of it, from the files' headers,
+    before anything is decoded.
+
+    Parameters
+    ----------
+    original, filtered : (shape, dtype)
+        What the two files declare (``aarecovery.io.read.declared_image``).
+    tile : int
+        The tile side the recovery will use.
+    maps : bool
+    max_bytes : int or float, optional
+        The limit; by default ``aarecovery.io.limits.max_bytes_from``.
+    name : str, optional
+        The pair, for the message.
+    """
+    limit = max_bytes_from(max_bytes)
+    try:
+        o_layout, f_layout = (layout_of(np.broadcast_to(np.zeros((), dtype), shape), role)
+                              for (shape, dtype), role in ((original, "original"), (filtered, "filtered")))
+    except InputError:  # a layout the reader refuses, naming the file: let it
+        return
+    whole, working, _ = recovery_bytes(o_layout, f_layout, None, tile, maps)
+    if whole + working <= limit:
+        return
+    raise InputError(
+        f"{name + ': ' if name else ''}recovering this {f_layout.width}x{f_layout.height} pair holds about "
+        f"{format_bytes(whole + working)} at its peak ({format_bytes(whole)} for O, F and R whole"
+        f"{' and the maps' if maps else ''}, {format_bytes(working)} for one tile in RGBA float), over the "
+        f"{format_bytes(limit)} limit on image memory; {raise_the_limit(whole + working)}, or give tiled TIFFs, "
+        "which stream in bounded memory")
+
+
+def check_pair_files(original, filtered, tile, maps=False, max_bytes=None, name=None):
+    """Before decoding a pair of files: each image's declared size, then the recovery's peak,
+    against the limit (:func:`check_recovery_peak`). `filtered` None: F will be made from O,
+    of its size."""
+    declared = [declared_image(path) for path in (original, filtered) if path is not None]
+    for path, (shape, dtype) in zip((original, filtered), declared):
+        check_decoded_size(path, shape, dtype, max_bytes)
+    check_recovery_peak(declared[0], declared[-1], tile, maps=maps, max_bytes=max_bytes, name=name)

@@ -21,7 +21,7 @@ from .plan.order import check_order
 from .sample import array_sample
 from .tiling import DEFAULT_TILES, check_tile_size, halo_for, tiles
 
-__all__ = ["recover", "recover_tiles"]
+__all__ = ["recover", "recover_tiles", "tile_side"]
 
 
 def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
@@ -137,7 +137,7 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     own_engine = engine is None
     if own_engine:
         engine = Engine(backend, gl_path=gl_path)
-    tile = min(engine.capabilities.max_tile, tile_size or engine.capabilities.default_tile)
+    tile = tile_side(engine.capabilities, tile_size)
     try:
         return _recover_in_tiles(original, filtered, f_layout, plan, engine, tile, linear, return_maps)
     except MemoryError as error:
@@ -145,6 +145,11 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     finally:
         if own_engine:
             engine.release()
+
+
+def tile_side(capabilities, tile_size=None):
+    """The tile side :func:`recover` uses on a backend with these capabilities."""
+    return min(capabilities.max_tile, tile_size or capabilities.default_tile)
 
 
 def _out_of_memory(error, o_layout, f_layout, backend, tile, return_maps):
@@ -205,22 +210,25 @@ def recover_tiles(engine, read, plan, pieces, layout, *, linear=False, maps=Fals
     maps : RecoveryMaps or None
         The maps on `inner`, with ``maps=True``.
     """
-    pending = None
-    for inner, outer in pieces:
-        original, filtered = read(outer)
-        engine.set_images(original, filtered, linear=linear, blend_space=plan.blend_space)
-        engine.run(plan, maps=maps, wait=False)
-        crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
-        tile_maps = None
-        if maps:
-            whole = engine.maps()
-            tile_maps = RecoveryMaps(*(getattr(whole, name)[crop] for name in RecoveryMaps.NAMES))
-        started = engine.start_result(crop)
+    # The engine's lock for the whole pair: a thread sharing the engine waits, instead of
+    # loading its tiles between this one's load and readback.
+    with engine.lock:
+        pending = None
+        for inner, outer in pieces:
+            original, filtered = read(outer)
+            engine.set_images(original, filtered, linear=linear, blend_space=plan.blend_space)
+            engine.run(plan, maps=maps, wait=False)
+            crop = tuple(slice(i.start - o.start, i.stop - o.start) for i, o in zip(inner, outer))
+            tile_maps = None
+            if maps:
+                whole = engine.maps()
+                tile_maps = RecoveryMaps(*(getattr(whole, name)[crop] for name in RecoveryMaps.NAMES))
+            started = engine.start_result(crop)
+            if pending is not None:
+                yield _finished(pending, layout, into)
+            pending = (inner, started, tile_maps)
         if pending is not None:
             yield _finished(pending, layout, into)
-        pending = (inner, started, tile_maps)
-    if pending is not None:
-        yield _finished(pending, layout, into)
 
 
 def _finished(pending, layout, into):

@@ -11,12 +11,15 @@ streamed pair gives exactly what ``aarecovery.recover`` gives on the same pixels
 
 import os
 import queue
+import shutil
 import threading
 
 import numpy as np
 
 from .contract import check_same_size, check_values, layout_of
-from .io import write_image
+from .errors import InputError
+from .io import check_decoded_size, write_image
+from .io.limits import format_bytes
 from .io.formats import WRITE_FORMATS
 from .io.tiled import TiledTiffWriter, tiff_regions
 from .pipeline import recover_tiles
@@ -24,7 +27,8 @@ from .plan import make_plan
 from .sample import analysis_sample
 from .tiling import aligned_tiles, halo_for
 
-__all__ = ["open_pair", "resolve_tile", "stream_tile", "plan_pair", "recover_pair", "StreamedPair", "STREAM_TILE"]
+__all__ = ["open_pair", "check_room", "resolve_tile", "stream_tile", "plan_pair", "recover_pair", "StreamedPair",
+           "STREAM_TILE"]
 
 #: The largest tile a streamed pair is recovered in when no tile size is given (the NumPy
 #: backend's own 512 is smaller). Measured on 2 cores with GL on llvmpipe, an 8192 x 8192
@@ -101,17 +105,23 @@ def stream_tile(tile, iterations, reach=0):
     return max(16, (tile - 2 * halo_for(iterations, reach)) // 16 * 16)
 
 
-def open_pair(original_path, filtered_path, tile, iterations):
+def open_pair(original_path, filtered_path, tile, iterations, max_bytes=None):
     """Open a pair for streaming, or return None when it should be read whole.
 
     A pair streams when both files can be read in pieces (``aarecovery.io.tiled``) and it
     does not fit in one tile of side `tile` (from :func:`resolve_tile`); otherwise reading
     it whole costs no more.
 
+    Streaming bounds the memory, not what a file may claim: a 15 MB BigTIFF declaring
+    10^6 x 10^6 pixels streamed for hours. Each image's declared size is held to the same
+    limit as an image read whole (`max_bytes`, ``--max-image-memory``), which a genuine
+    gigapixel pair raises.
+
     Raises
     ------
     InputError
-        When both can be read in pieces but are not a pair (different sizes).
+        When both can be read in pieces but are not a pair (different sizes), or either
+        declares more than `max_bytes` decoded.
     """
     original = tiff_regions(original_path)
     if original is None:
@@ -124,11 +134,32 @@ def open_pair(original_path, filtered_path, tile, iterations):
             filtered.close()
         return None
     try:
+        for regions in (original, filtered):
+            check_decoded_size(regions.path, regions.shape, regions.dtype, max_bytes)
         return StreamedPair(original, filtered)
     except BaseException:
         original.close()
         filtered.close()
         raise
+
+
+def check_room(pair, output):
+    """Refuse a streamed result that will not fit on its disk, before hours of work.
+
+    The result has FILTERED's size, depth and kind of content, so its file takes about as
+    much as FILTERED's (the best estimate before it is compressed); a result written whole
+    (not TIFF) is assembled in memory, bounded by :func:`open_pair`'s limit.
+    """
+    folder = os.path.dirname(os.path.abspath(os.fspath(output)))
+    needed = os.path.getsize(pair.filtered.path)
+    try:
+        free = shutil.disk_usage(folder).free
+    except OSError:
+        return
+    if needed > free:
+        raise InputError(f"the result {output} will take about {format_bytes(needed)} (as much as the filtered "
+                         f"file {pair.filtered.path}) and the disk holding {folder} has {format_bytes(free)} free; "
+                         "free some space or write elsewhere (nothing was written)")
 
 
 def plan_pair(pair, parameters, *, mode, linear=False, blend_space=None, planner=make_plan):

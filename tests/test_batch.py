@@ -356,10 +356,12 @@ def test_a_filter_command_printing_a_10_mb_line_is_reported_in_a_short_line(tmp_
 def test_max_image_memory_is_the_limit_of_each_image_read(tmp_path, capsys):
     """A file declaring more than the limit fails alone, with the option that raises it."""
     write_pairs(tmp_path, ["small.png"])
-    big = shapes(96, seed=3)
+    big = shapes(400, seed=3)
     for sub, image in (("o", big), ("f", threshold(big))):
         write_image(tmp_path / sub / "big.png", image)
-    limit_gb = (40 * 50 * 3 + 96 * 96 * 3) / 2 / 1e9  # between the two images' decoded sizes
+    # Above the small pair's peak (its images and a tile's working set, 160 bytes a pixel:
+    # 0.34 MB), below the big image decoded (0.48 MB).
+    limit_gb = 0.0004
     status, out, err = run_batch(capsys, tmp_path / "o", tmp_path / "f", "-o", tmp_path / "r", "--backend", "numpy",
                                  "--max-image-memory", f"{limit_gb:.9f}")
     assert status == 1 and "1 recovered" in out and "1 failed" in out

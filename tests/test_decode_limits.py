@@ -8,6 +8,7 @@ first would run out of memory, or take minutes, instead of refusing in a moment.
 """
 
 import io
+import os
 import struct
 import subprocess
 import sys
@@ -19,9 +20,11 @@ import pytest
 import tifffile
 from PIL import Image
 
+import aarecovery
 from aarecovery import InputError, read_image, write_image
 from aarecovery.cli import main
 from aarecovery.io import DEFAULT_MAX_BYTES, check_decoded_size
+from test_cli_safety import full_folder  # noqa: F401 (a fixture)
 
 BOMB = (40000, 40000)  # height, width
 
@@ -175,3 +178,69 @@ def test_a_limit_that_is_not_a_positive_number_says_so(capsys, value):
         main(["recover", "o.png", "f.png", "-o", "r.png", "--max-image-memory", value])
     err = capsys.readouterr().err
     assert "a positive number of GB is needed" in err and repr(value) in err and "_gigabytes" not in err
+
+
+# --- streamed pairs and the peak of a recovery count against the limit (issue 20, item 7) -----------------
+
+def _tiled_pair(folder, size, *, noisy=False):
+    """A tiled BigTIFF pair of `size` x `size` RGB that streams; flat (tiny files) unless `noisy`."""
+    import tifffile
+
+    rng = np.random.default_rng(0)
+    original = rng.integers(0, 256, (size, size, 3), dtype=np.uint8) if noisy else np.full((size, size, 3), 90,
+                                                                                           np.uint8)
+    filtered = np.where(original > 127, 255, 0).astype(np.uint8) if not noisy else original[::-1].copy()
+    paths = []
+    for name, image in (("o.tif", original), ("f.tif", filtered)):
+        tifffile.imwrite(folder / name, image, tile=(256, 256), bigtiff=True, photometric="rgb",
+                         compression=None if noisy else "zlib")
+        paths.append(folder / name)
+    return paths
+
+
+def test_a_streamed_pair_that_declares_more_than_the_limit_is_refused(tmp_path, capsys, backend):
+    original, filtered = _tiled_pair(tmp_path, 2048)
+    assert os.path.getsize(filtered) < 200_000   # 12.6 MB declared
+    status = main(["recover", str(original), str(filtered), "-o", str(tmp_path / "r.tif"), "--backend", backend,
+                   "--max-image-memory", "0.005"])
+    err = capsys.readouterr().err
+    assert status == 1 and err.startswith("aarecovery: error: ") and len(err.splitlines()) == 1, err
+    assert "2048x2048" in err and "--max-image-memory" in err
+    assert not (tmp_path / "r.tif").exists()
+    status = main(["batch", str(tmp_path / "o.ti[f]"), str(tmp_path / "f.ti[f]"), "-o", str(tmp_path / "r"),
+                   "--backend", backend, "--max-image-memory", "0.005"])
+    err = capsys.readouterr().err
+    assert status == 1 and "failed: f.tif" in err and "--max-image-memory" in err
+    assert not (tmp_path / "r" / "f.tif").exists()
+
+
+def _grey_png_pair(folder, size):
+    ramp = np.tile(np.linspace(0, 255, size).astype(np.uint8), (size, 1))
+    aarecovery.write_image(folder / "o.png", ramp)
+    aarecovery.write_image(folder / "f.png", np.where(ramp > 127, 255, 0).astype(np.uint8))
+    return folder / "o.png", folder / "f.png"
+
+
+def test_the_peak_of_a_recovery_counts_against_the_limit_not_only_the_decoded_images(tmp_path, capsys, backend):
+    original, filtered = _grey_png_pair(tmp_path, 600)     # 0.36 MB decoded each
+    status = main(["recover", str(original), str(filtered), "-o", str(tmp_path / "r.png"), "--backend", backend,
+                   "--max-image-memory", "0.002"])
+    err = capsys.readouterr().err
+    assert status == 1 and err.startswith("aarecovery: error: ") and len(err.splitlines()) == 1, err
+    assert "600x600" in err and "peak" in err and "--max-image-memory" in err
+    assert not (tmp_path / "r.png").exists()
+    results = aarecovery.recover_many([(original, filtered)], tmp_path / "r", backend=backend, max_bytes=2e6)
+    assert results[0].status == "failed" and "peak" in results[0].error
+    status = main(["recover", str(original), str(filtered), "-o", str(tmp_path / "r.png"), "--backend", backend,
+                   "--max-image-memory", "0.5"])
+    assert status == 0, capsys.readouterr().err
+
+
+def test_a_streamed_result_larger_than_the_free_disk_space_is_refused(tmp_path, capsys, full_folder):
+    original, filtered = _tiled_pair(tmp_path, 1280, noisy=True)   # 4.9 MB files; the disk has 1 MB
+    status = main(["recover", str(original), str(filtered), "-o", str(full_folder / "r.tif"), "--backend",
+                   "numpy", "--paper"])
+    err = capsys.readouterr().err
+    assert status == 1 and err.startswith("aarecovery: error: ") and len(err.splitlines()) == 1, err
+    assert str(full_folder) in err and "free" in err and "as much as" in err
+    assert os.listdir(full_folder) == []

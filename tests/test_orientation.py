@@ -106,3 +106,45 @@ def test_size_mismatch_without_tags_says_nothing_of_orientation(tmp_path, capsys
     aarecovery.write_image(tmp_path / "f.png", edge_scene((28, 40))[1])
     status, err = run_recover(capsys, tmp_path / "o.png", tmp_path / "f.png", "-o", tmp_path / "r.png")
     assert status == 1 and "orientation" not in err
+
+
+def _square_pair_with_o_tagged(tmp_path, extension=".png"):
+    """O tagged orientation 6 and F untagged, F made from O's stored (unturned) pixels: a square
+    pair whose sizes match while F is misaligned with O as read."""
+    original, filtered = edge_scene((32, 32))
+    save_tagged(tmp_path / f"o{extension}", original, 6)
+    save_tagged(tmp_path / f"f{extension}", filtered, 1)
+    return tmp_path / f"o{extension}", tmp_path / f"f{extension}"
+
+
+@pytest.mark.parametrize("extension", [".png", ".tif"])
+def test_recover_warns_in_one_line_when_the_orientation_tags_differ(tmp_path, capsys, extension, backend):
+    original, filtered = _square_pair_with_o_tagged(tmp_path, extension)
+    status = main(["recover", str(original), str(filtered), "-o", str(tmp_path / "r.png"), "--backend", backend])
+    err = capsys.readouterr().err
+    assert status == 0, err
+    warnings = [line for line in err.splitlines() if "orientation" in line]
+    assert len(warnings) == 1 and warnings[0].startswith("aarecovery: warning: "), err
+    assert "orientation 6" in warnings[0] and "orientation 1" in warnings[0]
+
+
+def test_batch_warns_for_each_pair_whose_orientation_tags_differ(tmp_path, capsys):
+    for sub in ("o", "f"):
+        (tmp_path / sub).mkdir()
+    original, filtered = edge_scene((32, 32))
+    save_tagged(tmp_path / "o" / "a.png", original, 6)
+    save_tagged(tmp_path / "f" / "a.png", filtered, 1)
+    save_tagged(tmp_path / "o" / "b.png", original, 1)
+    save_tagged(tmp_path / "f" / "b.png", filtered, 1)
+    status = main(["batch", str(tmp_path / "o"), str(tmp_path / "f"), "-o", str(tmp_path / "r"), "--backend",
+                   "numpy"])
+    err = capsys.readouterr().err
+    assert status == 0, err
+    warnings = [line for line in err.splitlines() if "orientation" in line]
+    assert len(warnings) == 1 and warnings[0].startswith("aarecovery: warning: a.png: "), err
+
+
+def test_the_library_warns_with_orientation_warning(tmp_path):
+    original, filtered = _square_pair_with_o_tagged(tmp_path)
+    with pytest.warns(aarecovery.OrientationWarning, match="orientation 6"):
+        aarecovery.recover_many([(original, filtered)], tmp_path / "r", backend="numpy")

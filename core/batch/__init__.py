@@ -11,9 +11,9 @@ from .api import make_jobs, make_settings, recover_many, run_jobs
 from .filtering import BuiltinFilter, FilterCommand, FilterFailed
 from .jobs import IMAGE_EXTENSIONS, Job, find_images, find_pairs
 from .local import default_workers
-from .report import check_report_path, summary, write_report
+from .report import check_report_path, read_report, summary, write_report
 from .work import REPORT_FIELDS, ImageResult, Settings
 
 __all__ = ["recover_many", "run_jobs", "make_jobs", "make_settings", "BuiltinFilter", "FilterCommand",
            "FilterFailed", "Job", "IMAGE_EXTENSIONS", "find_images", "find_pairs", "default_workers",
-           "write_report", "check_report_path", "summary", "ImageResult", "Settings", "REPORT_FIELDS"]
+           "write_report", "read_report", "check_report_path", "summary", "ImageResult", "Settings", "REPORT_FIELDS"]

@@ -10,6 +10,7 @@ from ..params import (DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, STRENGTH, Para
                       check_blend_space, check_gl_path, check_mode)
 from ..tiling import check_tile_size
 from . import storage
+from .destinations import check_batch_destinations
 from .filtering import BuiltinFilter, FilterCommand
 from .jobs import Job, output_name
 from .local import run_local
@@ -153,9 +154,10 @@ def recover_many(pairs, output=None, *, filter=None, filter_params=None, filter_
     sigma_d, sigma_e, iterations, backend, linear, blend_space, tile_size, mode, strength, gl_path
         As for :func:`aarecovery.recover`, for every image.
     max_bytes : int or float, optional
-        The largest decoded size of one image read whole, as for :func:`aarecovery.read_image`
-        (default 4 GB, or ``AARECOVERY_MAX_IMAGE_MEMORY``); streamed TIFF pairs are read in
-        tiles and are not bound by it.
+        The largest decoded size of one image, as for :func:`aarecovery.read_image` (default
+        4 GB, or ``AARECOVERY_MAX_IMAGE_MEMORY``), and of a recovery's peak for a pair read
+        whole; a streamed TIFF pair holds only tiles, but each image's declared size is
+        bound by it too.
     engine : Engine, optional
         An engine to use (not with `dask`).
 
@@ -179,6 +181,7 @@ def recover_many(pairs, output=None, *, filter=None, filter_params=None, filter_
                              tile_size=tile_size, mode=mode, strength=strength, gl_path=gl_path,
                              max_bytes=max_bytes)
     jobs = make_jobs(pairs, settings.filter is not None)
+    check_batch_destinations(jobs, settings)
     return run_jobs(jobs, settings, workers=workers, progress=progress, dask=dask, engine=engine)
 
 

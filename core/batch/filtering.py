@@ -6,8 +6,8 @@ or ``gegl {in} -o {out} -- gegl:levels in-high=0.6``. It is split into words fir
 shell quoting rules, no shell runs it), then ``{in}`` and ``{out}`` are replaced inside
 each word, so paths with spaces need no quoting. The command reads a temporary copy of
 the original, so a tool that writes into its input cannot touch it, and writes a file in
-the same temporary folder, in the original's format unless ``{out}`` is given an
-extension (``{out}.png``); a non-zero exit status, or no output file, fails that image with
+the same temporary folder, in the original's format when it is lossless, else PNG, unless
+``{out}`` is given an extension (``{out}.jpg``); a non-zero exit status, or no output file, fails that image with
 the tool's own message.
 """
 
@@ -21,6 +21,7 @@ import threading
 from dataclasses import dataclass, field
 
 from ..errors import InputError
+from ..io.formats import lossless_extension
 
 __all__ = ["BuiltinFilter", "FilterCommand", "FilterFailed"]
 
@@ -98,6 +99,19 @@ class FilterCommand:
     def describe(self):
         return self.template
 
+    def _chosen_extension(self):
+        """The extension the template gives ``{out}`` (``{out}.png``), or None."""
+        chosen = re.search(r"\{out\}(\.\w+)", self.template)
+        return chosen.group(1) if chosen else None
+
+    def output_extension(self, original_path):
+        """The extension of the file the command writes for `original_path`: the template's
+        (``{out}.jpg``), else the original's when lossless, else ``.png``.
+
+        A JPEG F would add its own artefacts to the filter's result (a threshold came back
+        with 52 grey levels), and F's values are what the recovery fits."""
+        return self._chosen_extension() or lossless_extension(os.path.splitext(original_path)[1])
+
     def run(self, original_path, folder):
         """Run the command on a copy of `original_path` inside `folder`; return the output's path.
 
@@ -106,13 +120,11 @@ class FilterCommand:
         FilterFailed
             On a non-zero exit status, a time-out, or no output file.
         """
-        extension = os.path.splitext(original_path)[1]
-        copy = os.path.join(folder, "original" + extension)
+        copy = os.path.join(folder, "original" + os.path.splitext(original_path)[1])
         shutil.copyfile(original_path, copy)
-        chosen = re.search(r"\{out\}(\.\w+)", self.template)
         output = os.path.join(folder, "filtered")
-        produced = output + (chosen.group(1) if chosen else extension)
-        target = output if chosen else produced
+        produced = output + self.output_extension(original_path)
+        target = output if self._chosen_extension() else produced
         words = [word.replace("{in}", copy).replace("{out}", target) for word in self.words()]
         returncode, stderr = _run_as_group(words, self.timeout, folder, self.template)
         message = _tool_message(stderr)

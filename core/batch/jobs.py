@@ -15,7 +15,7 @@ from ..errors import InputError
 from ..io.formats import WRITE_FORMATS
 from . import storage
 
-__all__ = ["Job", "IMAGE_EXTENSIONS", "find_pairs", "find_images", "output_name"]
+__all__ = ["Job", "IMAGE_EXTENSIONS", "find_pairs", "find_images", "output_name", "source_folder"]
 
 #: Files a folder contributes to a batch, by extension (what ``read_image`` reads).
 IMAGE_EXTENSIONS = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".webp", ".bmp", ".gif", ".npy")
@@ -121,6 +121,11 @@ def _glob_images(pattern):
             name = path[len(root):].lstrip("/") if storage.is_url(path) else _relative(path, root)
             found[key] = (name, path)
     return found
+
+
+def source_folder(source):
+    """The folder a batch source reads images from: the folder itself, or a glob's fixed part."""
+    return _glob_root(source) if _is_glob(source) else source
 
 
 def find_images(source):

@@ -97,10 +97,17 @@ def run_local(jobs, settings, engine, *, workers=None, progress=None, started=No
             for _, future in prepared:
                 if not future.cancel():
                     _discard(future)
-            for _, future, work in storing:
+            writing = []
+            for index, future, work in storing:
                 if future.cancel():
                     work.finished()
+                else:
+                    writing.append((index, future, work))
             pool.shutdown(wait=True, cancel_futures=True)
+            # The images whose writing had begun are on disk now: count and report them.
+            for item in writing:
+                with contextlib.suppress(Exception):
+                    finish(*item)
             raise
     return results
 

@@ -19,17 +19,20 @@ from dataclasses import dataclass, field, fields
 from .. import stream
 from ..contract import check_same_size, check_values, layout_of
 from ..errors import InputError
-from ..io import check_output_path, os_error_line, read_image, write_image
-from ..io.maps import write_maps
+from ..io import check_output_path, os_error_line, read_image, warn_if_orientations_differ, write_image, write_images
+from ..io.formats import lossless_extension
+from ..io.maps import map_paths, maps_as_images
 from ..params import Parameters
-from ..pipeline import recover
+from ..memory import check_pair_files
+from ..pipeline import recover, tile_side
 from ..plan import make_plan
 from ..sample import array_sample
 from . import storage
 from .filtering import BuiltinFilter, FilterCommand
 from .jobs import output_name
 
-__all__ = ["Settings", "ImageResult", "Work", "prepare", "compute", "store", "run_one", "fail", "REPORT_FIELDS"]
+__all__ = ["Settings", "ImageResult", "Work", "prepare", "compute", "store", "run_one", "fail", "REPORT_FIELDS",
+           "destinations", "kept_filtered_path", "maps_folder"]
 
 
 @dataclass(frozen=True)
@@ -207,20 +210,15 @@ def _is_path(value):
     return isinstance(value, (str, os.PathLike))
 
 
-def _same_file(first, second):
-    try:
-        return os.path.samefile(first, second)
-    except OSError:
-        return os.path.realpath(first) == os.path.realpath(second)
-
-
-def _up_to_date(output, inputs):
-    """The result exists (so it is complete: every write is atomic) and is newer than its inputs."""
+def _up_to_date(job, settings, output, inputs):
+    """The result exists (so it is complete: every write is atomic) and is newer than its
+    inputs, and every other file of the image (kept F, maps) exists."""
     made = storage.modified(output)
     if made is None:
         return False
     stamps = [storage.modified(path) for path in inputs]
-    return all(stamp is not None and stamp <= made for stamp in stamps)
+    return all(stamp is not None and stamp <= made for stamp in stamps) and \
+        all(storage.exists(path) for role, path in destinations(job, settings) if role != "result")
 
 
 def remove_stale_parts(output, before):
@@ -239,7 +237,33 @@ def remove_stale_parts(output, before):
 
 def _kept_path(folder, name, extension=None):
     stem, own = os.path.splitext(name)
-    return os.path.join(folder, *(stem + (extension or own)).split("/"))
+    return os.path.join(folder, *(stem + (own if extension is None else extension)).split("/"))
+
+
+def kept_filtered_path(settings, job):
+    """Where the filtered image the batch makes for `job` is kept (``settings.keep_filtered``)."""
+    if isinstance(settings.filter, FilterCommand):
+        original = os.fspath(job.original) if _is_path(job.original) else job.name
+        return _kept_path(settings.keep_filtered, job.name, settings.filter.output_extension(original))
+    return _kept_path(settings.keep_filtered, job.name, lossless_extension(os.path.splitext(job.name)[1]))
+
+
+def maps_folder(settings, job):
+    """The folder `job`'s maps are written into (``settings.maps``/NAME without its extension)."""
+    return _kept_path(settings.maps, job.name, "")
+
+
+def destinations(job, settings):
+    """``(role, path)`` of every file the batch writes for `job`: its result, the filtered
+    image it keeps, its maps (none without an output folder)."""
+    if settings.output is None:
+        return
+    yield "result", storage.join(settings.output, output_name(job.name, settings.format))
+    if settings.keep_filtered is not None and job.filtered is None:
+        yield "kept filtered image", kept_filtered_path(settings, job)
+    if settings.maps is not None:
+        for path in map_paths(maps_folder(settings, job)).values():
+            yield "map", path
 
 
 def prepare(job, settings, capabilities, started, planner=make_plan):
@@ -272,13 +296,8 @@ def _prepare(work, settings, capabilities, started, planner):
     inputs = [os.fspath(path) for path in (job.original, job.filtered) if _is_path(path)]
     if settings.output is not None:
         work.output = work.target = storage.join(settings.output, output_name(job.name, settings.format))
-        for role, path in zip(("original", "filtered"), (job.original, job.filtered)):
-            if _is_path(path) and not settings.overwrite and not storage.is_url(path) and \
-                    not storage.is_url(work.output) and _same_file(work.output, path):
-                raise InputError(f"the result {work.output} would replace the {role} image; choose another "
-                                 "output folder, or pass --overwrite")
         remove_stale_parts(work.output, started)
-        if not settings.force and inputs and _up_to_date(work.output, inputs):
+        if not settings.force and inputs and _up_to_date(job, settings, work.output, inputs):
             result.status, result.output = "skipped", work.output
             return
         if storage.is_url(work.output):
@@ -296,15 +315,19 @@ def _prepare(work, settings, capabilities, started, planner):
     if streamable:
         work.pair = stream.open_pair(original_path, filtered_path,
                                      stream.resolve_tile(capabilities, settings.tile_size),
-                                     settings.parameters.iterations)
+                                     settings.parameters.iterations, max_bytes=settings.max_bytes)
     if work.pair is not None:
         result.streamed = True
         result.height, result.width = work.pair.height, work.pair.width
         result.dtype = str(work.pair.result_dtype)
         check_output_path(work.target, work.pair.result_shape)
+        stream.check_room(work.pair, work.target)
         work.plan = stream.plan_pair(work.pair, settings.parameters, mode=settings.mode, linear=settings.linear,
                                      blend_space=settings.blend_space, planner=planner)
     else:
+        if original_path:
+            check_pair_files(original_path, filtered_path, tile_side(capabilities, settings.tile_size),
+                             maps=settings.maps is not None, max_bytes=settings.max_bytes)
         original = read_image(original_path, max_bytes=settings.max_bytes) if original_path else job.original
         if filtered_path:
             filtered = read_image(filtered_path, max_bytes=settings.max_bytes)
@@ -322,6 +345,8 @@ def _prepare(work, settings, capabilities, started, planner):
         work.original, work.filtered = original, filtered
         work.plan = planner(*array_sample(original, filtered), settings.parameters, mode=settings.mode,
                             linear=settings.linear, blend_space=settings.blend_space)
+    if original_path and filtered_path:
+        warn_if_orientations_differ(original_path, filtered_path, job.name)
     plan = work.plan
     result.mode, result.blend_space, result.strength, result.reason = (plan.mode, plan.blend_space, plan.strength,
                                                                       plan.reason)
@@ -358,17 +383,20 @@ def store(work, settings):
         return result
     try:
         with _Timed(result):
-            if work.output is not None and work.pair is None:
-                write_image(work.target, work.recovered)
-            elif work.output is None:
+            if work.output is None:
                 result.image = work.recovered
-            if work.target != work.output:
-                storage.publish(work.target, work.output)
-            _keep_filtered(work, settings)
-            if settings.maps is not None and work.maps is not None:
-                folder = _kept_path(settings.maps, work.job.name, "")
-                os.makedirs(folder, exist_ok=True)
-                write_maps(folder, work.maps)
+            else:
+                _keep_filtered(work, settings)
+                images = {} if work.pair is not None else {work.target: work.recovered}
+                if settings.maps is not None and work.maps is not None:
+                    folder = maps_folder(settings, work.job)
+                    os.makedirs(folder, exist_ok=True)
+                    images.update(maps_as_images(folder, work.maps))
+                # The result last and with its maps, all or none: a result that exists means
+                # that every file of the image was written (a re-run skips it).
+                write_images(images)
+                if work.target != work.output:
+                    storage.publish(work.target, work.output)
         result.output = work.output
         result.status = "done"
     except Exception as error:
@@ -382,7 +410,7 @@ def _keep_filtered(work, settings):
     if settings.keep_filtered is None or work.job.filtered is not None:
         return
     if work.filtered_file is not None:
-        kept = _kept_path(settings.keep_filtered, work.job.name, os.path.splitext(work.filtered_file)[1])
+        kept = kept_filtered_path(settings, work.job)
         os.makedirs(os.path.dirname(kept), exist_ok=True)
         # The tool's own file, byte for byte, renamed into place.
         descriptor, temporary = tempfile.mkstemp(dir=os.path.dirname(kept), prefix=".kept.", suffix=".part")
@@ -395,7 +423,7 @@ def _keep_filtered(work, settings):
                 os.unlink(temporary)
             raise
     elif work.filtered is not None:
-        kept = _kept_path(settings.keep_filtered, work.job.name)
+        kept = kept_filtered_path(settings, work.job)
         os.makedirs(os.path.dirname(kept), exist_ok=True)
         write_image(kept, work.filtered)
 

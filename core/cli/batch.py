@@ -8,7 +8,7 @@ import sys
 import time
 
 from ..errors import InputError
-from .inputs import add_image_memory_option
+from .inputs import add_image_memory_option, memory_limit
 from .recover import add_recovery_options
 from .text import printable
 
@@ -36,9 +36,11 @@ examples:
   aarecovery batch originals/ filtered/ -o repaired/ --dask tcp://scheduler:8786
 
 filter commands: the template is split into words like a shell would (no shell runs it);
-{in} is a temporary copy of the original, {out} the file the tool must write, in the
-original's format unless written with an extension ({out}.png). ImageMagick 6 is
-'convert', ImageMagick 7 'magick'. For pipes or redirection run a shell: 'sh -c "..."'.
+{in} is a temporary copy of the original, {out} the file the tool must write: lossless, in
+the original's format when that is lossless (PNG, TIFF, ...), else PNG (for a JPEG, WebP or
+GIF original), unless written with an extension ({out}.jpg). A filtered image the batch
+keeps (--keep-filtered) is lossless the same way. ImageMagick 6 is 'convert', ImageMagick 7
+'magick'. For pipes or redirection run a shell: 'sh -c "..."'.
 """
 
 
@@ -177,6 +179,8 @@ def _check_paths_for_a_cluster(args, is_url):
 def run(args):
     """Run ``aarecovery batch`` with parsed arguments; return the exit status."""
     from ..batch import ImageResult, check_report_path, make_settings, run_jobs, summary, write_report
+    from ..batch.destinations import check_batch_destinations
+    from ..batch.jobs import source_folder
     from ..batch.storage import is_url
 
     _check_paths_for_a_cluster(args, is_url)
@@ -194,8 +198,12 @@ def run(args):
         overwrite=args.overwrite, sigma_d=args.sigma_d, sigma_e=args.sigma_e, iterations=args.iterations,
         strength=args.strength, gl_path=args.gl_path, backend=args.backend, linear=args.linear,
         blend_space=args.blend_space, tile_size=args.tile_size, mode="paper" if args.paper else "safe",
-        max_bytes=None if args.max_image_memory is None else args.max_image_memory * 1e9, **_filter_options(args))
+        max_bytes=memory_limit(args), **_filter_options(args))
     jobs, unmatched = _jobs(args, settings.filter is not None)
+    # Every destination before anything is read, filtered or written.
+    check_batch_destinations(jobs, settings, report=args.report,
+                             sources=[source_folder(source) for source in (args.originals, args.filtered)
+                                      if source is not None and not is_url(source)])
     missing = [ImageResult(os.path.relpath(path, args.originals) if os.path.isdir(args.originals) else path,
                            status="failed", error=f"no filtered image matches {path}") for path in unmatched]
     if not args.dask and not is_url(args.output):

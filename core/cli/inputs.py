@@ -4,10 +4,9 @@ import argparse
 
 from ..contract import check_same_size, layout_of
 from ..errors import InputError
-from ..io import DEFAULT_MAX_BYTES, orientation_tag, read_image
-from ..io.orientation import ORIENTATION_NAMES
+from ..io import DEFAULT_MAX_BYTES, describe_orientations, read_image, warn_if_orientations_differ
 
-__all__ = ["add_image_memory_option", "read_input", "check_pair_size"]
+__all__ = ["add_image_memory_option", "memory_limit", "read_input", "check_pair_size"]
 
 
 def _gigabytes(text):
@@ -24,19 +23,26 @@ def _gigabytes(text):
 def add_image_memory_option(parser):
     """``--max-image-memory GB``: raise (or lower) the decompression-bomb limit of every read."""
     parser.add_argument("--max-image-memory", type=_gigabytes, metavar="GB",
-                        help="largest decoded size of one image, checked from the file's header before "
-                             f"decoding (default {DEFAULT_MAX_BYTES / 1e9:g} GB; larger files are refused as "
-                             "possible decompression bombs)")
+                        help="largest decoded size of one image, and of a recovery's peak (O, F, R and a "
+                             "tile), checked from the files' headers before decoding (default "
+                             f"{DEFAULT_MAX_BYTES / 1e9:g} GB; larger files are refused as possible decompression "
+                             "bombs)")
+
+
+def memory_limit(args):
+    """The command's ``--max-image-memory`` in bytes, or None for the default."""
+    limit = getattr(args, "max_image_memory", None)
+    return None if limit is None else limit * 1e9
 
 
 def read_input(path, args):
     """:func:`aarecovery.read_image` with the command's ``--max-image-memory``."""
-    limit = getattr(args, "max_image_memory", None)
-    return read_image(path, max_bytes=None if limit is None else limit * 1e9)
+    return read_image(path, max_bytes=memory_limit(args))
 
 
 def check_pair_size(original, filtered, paths):
-    """Refuse a pair of different sizes; say so when the files declare different orientations.
+    """Refuse a pair of different sizes, saying so when the files declare different
+    orientations; warn when the sizes match but the orientations differ.
 
     Every reader turns pixels upright by the orientation the file declares; a program that
     dropped the tag without turning the pixels leaves a pair that no longer matches.
@@ -44,11 +50,10 @@ def check_pair_size(original, filtered, paths):
     try:
         check_same_size(layout_of(original, "original"), layout_of(filtered, "filtered"))
     except InputError as error:
-        tags = [orientation_tag(path) for path in paths]
-        if tags[0] == tags[1]:
+        described = describe_orientations(paths)
+        if described is None:
             raise
-        described = " but ".join(f"{role} is tagged orientation {tag} ({ORIENTATION_NAMES[tag]} for display)"
-                                 for role, tag in zip(("ORIGINAL", "FILTERED"), tags))
         raise InputError(f"{error}. The files' orientation tags differ: {described}; each is shown upright "
                          "as tagged, so the program that wrote one of them may have dropped or changed the "
                          "tag without turning its pixels") from None
+    warn_if_orientations_differ(*paths)

@@ -1,65 +1,12 @@
-"""Where a command may write: never over its own inputs, and only where every write can succeed.
-
-Every command that writes files checks all of its destinations with :func:`check_destinations`
-before it reads or computes anything, so that a run never ends in a refusal after part of its
-output was written.
-"""
+"""Where a command may write: :func:`check_destinations` (``aarecovery.io.destinations``, which
+the batch shares), and the part files that interrupted runs left beside the outputs."""
 
 import os
 
-from ..errors import InputError
-from ..io import check_output_path, check_writable_folder, remove_stale_parts
+from ..io import remove_stale_parts
+from ..io.destinations import check_destinations, same_file
 
 __all__ = ["check_destinations", "remove_stale_parts_of", "same_file"]
-
-
-def same_file(first, second):
-    """True when two paths name the same file (through links, ``..`` or hard links)."""
-    if os.path.exists(first) and os.path.exists(second):
-        return os.path.samefile(first, second)
-    return os.path.realpath(first) == os.path.realpath(second)
-
-
-def check_destinations(outputs, inputs, *, overwrite=False, folders=()):
-    """Refuse outputs that would replace an input, and destinations that cannot be written.
-
-    Parameters
-    ----------
-    outputs : list of str
-        The image files the command will write.
-    inputs : dict
-        ``{role: path}`` of the images the command reads (``"original"``, ``"filtered"``...).
-    overwrite : bool
-        The user's ``--overwrite``: an output may then replace an input.
-    folders : iterable of str
-        Folders the command creates if missing (``--maps DIR``); their nearest existing
-        ancestor must be writable.
-
-    Raises
-    ------
-    InputError
-        Naming the output and the input it would replace (and ``--overwrite``), an unknown
-        extension, a missing folder, or a folder that cannot be written.
-    """
-    for output in outputs:
-        for role, source in inputs.items():
-            if not overwrite and same_file(output, source):
-                raise InputError(f"output {output} is the {role} image {source}; choose another output "
-                                 "name, or pass --overwrite to replace it")
-    created = [os.path.abspath(folder) for folder in folders]
-    for output in outputs:
-        if not any(os.path.abspath(output).startswith(folder + os.sep) for folder in created):
-            check_output_path(output)
-    checked = set()
-    for folder in [os.path.dirname(os.path.abspath(output)) for output in outputs] + created:
-        existing = folder
-        while not os.path.exists(existing):
-            existing = os.path.dirname(existing)
-        if not os.path.isdir(existing):
-            raise InputError(f"{existing} is a file, so the folder {folder} cannot be made; choose another folder")
-        if existing not in checked:
-            checked.add(existing)
-            check_writable_folder(existing)
 
 
 def remove_stale_parts_of(outputs):

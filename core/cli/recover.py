@@ -97,13 +97,18 @@ def add_parameter_options(parser):
                             help=f"{spec.help} ({spec.minimum:g} to {spec.maximum:g}; {default})")
 
 
-def _read_pair(args):
-    """Decode both images in two threads: the codecs release the GIL."""
+def _read_pair(args, engine):
+    """Decode both images in two threads (the codecs release the GIL), once the recovery's
+    peak is known to fit the image memory limit."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from .inputs import check_pair_size, read_input
+    from ..memory import check_pair_files
+    from ..pipeline import tile_side
+    from .inputs import check_pair_size, memory_limit, read_input
 
     paths = (args.original, args.filtered)
+    check_pair_files(*paths, tile_side(engine.capabilities, args.tile_size), maps=args.maps is not None,
+                     max_bytes=memory_limit(args))
     with ThreadPoolExecutor(max_workers=2) as pool:
         original, filtered = pool.map(lambda path: read_input(path, args), paths)
     check_pair_size(original, filtered, paths)
@@ -144,7 +149,7 @@ def run(args):
                 for line in _recover_streamed(args, params, pair, engine):
                     print(printable(line))
             return 0
-        original, filtered = _read_pair(args)
+        original, filtered = _read_pair(args, engine)
         # Before the recovery, so that a long run does not end in a refusal.
         check_output_path(args.output, filtered.shape)
         start = time.perf_counter()
@@ -186,10 +191,15 @@ def summary_line(plan, original=None, filtered=None, recovered=None, linear=Fals
 
 def _open_streamed(args, params, engine):
     """A pair of TIFFs that can be read in pieces and is larger than a tile, else None."""
+    from ..io import warn_if_orientations_differ
     from ..stream import open_pair, resolve_tile
+    from .inputs import memory_limit
 
-    return open_pair(args.original, args.filtered, resolve_tile(engine.capabilities, args.tile_size),
-                     params.iterations)
+    pair = open_pair(args.original, args.filtered, resolve_tile(engine.capabilities, args.tile_size),
+                     params.iterations, max_bytes=memory_limit(args))
+    if pair is not None:
+        warn_if_orientations_differ(args.original, args.filtered)
+    return pair
 
 
 def _recover_streamed(args, params, pair, engine):
@@ -197,9 +207,10 @@ def _recover_streamed(args, params, pair, engine):
     import time
 
     from ..io import check_output_path
-    from ..stream import plan_pair, recover_pair
+    from ..stream import check_room, plan_pair, recover_pair
 
     check_output_path(args.output, pair.result_shape)
+    check_room(pair, args.output)
     start = time.perf_counter()
     plan = plan_pair(pair, params, mode="paper" if args.paper else "safe", linear=args.linear,
                      blend_space=args.blend_space)

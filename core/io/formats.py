@@ -6,13 +6,25 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["WRITE_FORMATS", "READ_FORMATS", "NPY_DTYPES", "import_codec", "layout_name"]
+__all__ = ["WRITE_FORMATS", "READ_FORMATS", "NPY_DTYPES", "LOSSLESS_EXTENSIONS", "lossless_extension", "import_codec",
+           "layout_name"]
 
 #: Output extensions and the format each one writes.
 WRITE_FORMATS = {
     ".png": "PNG", ".tif": "TIFF", ".tiff": "TIFF", ".npy": "NPY",
     ".jpg": "JPEG", ".jpeg": "JPEG", ".webp": "WEBP", ".bmp": "BMP",
 }
+#: Extensions whose files keep every value written (8 and 16-bit PNG; TIFF and .npy up to
+#: float; 8-bit BMP).
+LOSSLESS_EXTENSIONS = (".png", ".tif", ".tiff", ".npy", ".bmp")
+
+
+def lossless_extension(extension):
+    """`extension` when its format is lossless, else ``".png"``: the lossy and palette formats
+    (JPEG, WebP, GIF...) hold at most 8 bits per channel, which PNG keeps exactly."""
+    return extension if extension.lower() in LOSSLESS_EXTENSIONS else ".png"
+
+
 #: What :func:`aarecovery.read_image` reads, for messages.
 READ_FORMATS = ("PNG (8/16-bit), TIFF (8/16-bit, 32-bit float), NumPy .npy (uint8, uint16, float32, "
                 "float64), and as 8-bit JPEG, WebP, BMP, GIF and the other formats Pillow reads")

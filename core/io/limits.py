@@ -5,12 +5,15 @@ decompression bomb). Every reader asks :func:`check_decoded_size` with the shape
 is about to decode, before it decodes anything. The limit is on what is decoded into memory
 at once: a reader that decodes a large file piece by piece checks each piece, not the whole.
 
-Why 4 GB by default: ``recover`` holds O, F and R whole (R at F's depth) and one tile's
-working set beside them (about 0.5 GB on GL), so a pair of images at the limit needs about
-3 x 4 + 0.5 = 12.5 GB, what a 16 GB workstation can give; measured, a 20000 x 20000 RGB pair
-(1.2 GB per image) peaked at 4.6 GB. The documented large cases pass: 20000 x 20000 RGB
-8-bit (1.2 GB) and even 16-bit RGBA (3.2 GB); the 40000 x 40000 RGB bomb (4.8 GB once
-decoded, from a 1.5 MB PNG or a 1.2 MB GIF) is refused before decoding.
+Why 4 GB by default: what a 16 GB workstation gives a recovery with room to spare. The
+commands hold more than the decoded images to it: ``recover`` holds O, F and R whole (R at
+F's depth) and one tile's working set in RGBA float beside them, and that peak is counted
+against the same limit before decoding (``aarecovery.memory.check_pair_files``; a 1.6 GB
+40000 x 40000 grey pair peaked at 5 GB). A 20000 x 20000 RGB 8-bit pair (1.2 GB per image,
+3.8 GB at its peak) passes; the 40000 x 40000 RGB bomb (4.8 GB once decoded, from a 1.5 MB
+PNG or a 1.2 MB GIF) is refused before decoding. A pair of tiled TIFFs that streams holds
+only tiles, but each image's declared size is held to the limit all the same, so that a
+small file cannot claim days of work (``aarecovery.stream.open_pair``).
 """
 
 import math
@@ -20,7 +23,8 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["DEFAULT_MAX_BYTES", "ENVIRONMENT_VARIABLE", "max_bytes_from", "check_decoded_size", "format_bytes"]
+__all__ = ["DEFAULT_MAX_BYTES", "ENVIRONMENT_VARIABLE", "max_bytes_from", "check_decoded_size", "format_bytes",
+           "DECLARED_ONLY", "Declared", "raise_the_limit"]
 
 #: The default limit on one decoded image, in bytes (see the module's text for why).
 DEFAULT_MAX_BYTES = 4 * 10**9
@@ -55,6 +59,24 @@ def max_bytes_from(max_bytes=None):
     return DEFAULT_MAX_BYTES
 
 
+#: A `max_bytes` that makes :func:`check_decoded_size` raise :class:`Declared` with what the
+#: file declares: every reader calls it from the header, before decoding, so that
+#: ``aarecovery.io.read.declared_image`` learns a file's size without a second header parser.
+DECLARED_ONLY = object()
+
+
+class Declared(BaseException):
+    """What a file declares (``shape``, ``dtype``), raised past every reader's error handling.
+
+    A BaseException: the readers turn any ``Exception`` met while decoding into their
+    "could not decode" message.
+    """
+
+    def __init__(self, shape, dtype):
+        super().__init__(shape, dtype)
+        self.shape, self.dtype = tuple(int(side) for side in shape), np.dtype(dtype)
+
+
 def check_decoded_size(path, shape, dtype, max_bytes=None):
     """Raise :class:`InputError` if decoding `shape` at `dtype` at once would exceed the limit.
 
@@ -69,6 +91,8 @@ def check_decoded_size(path, shape, dtype, max_bytes=None):
     max_bytes : int or float, optional
         The limit; by default :func:`max_bytes_from`.
     """
+    if max_bytes is DECLARED_ONLY:
+        raise Declared(shape, dtype)
     limit = max_bytes_from(max_bytes)
     needed = math.prod(int(side) for side in shape) * np.dtype(dtype).itemsize
     if needed <= limit:
@@ -79,6 +103,10 @@ def check_decoded_size(path, shape, dtype, max_bytes=None):
     raise InputError(
         f"{path} declares {width}x{height} {_LAYOUTS.get(channels, f'{channels}-channel')} {depth} pixels, "
         f"{format_bytes(needed)} once decoded, over the {format_bytes(limit)} limit for one image (a small file "
-        f"that claims this much is a decompression bomb); if it is genuine, raise the limit: --max-image-memory "
-        f"{math.ceil(needed / 1e8) / 10:g} on the command line, max_bytes= in read_image, or "
-        f"{ENVIRONMENT_VARIABLE} (GB)")
+        f"that claims this much is a decompression bomb); {raise_the_limit(needed)}")
+
+
+def raise_the_limit(needed):
+    """The end of a refusal by the limit: how to raise it to `needed` bytes."""
+    return (f"if it is genuine, raise the limit: --max-image-memory {math.ceil(needed / 1e8) / 10:g} on the "
+            f"command line, max_bytes= in read_image and recover_many, or {ENVIRONMENT_VARIABLE} (GB)")

@@ -7,15 +7,16 @@ are imported inside the functions, so ``import aarecovery`` needs only NumPy and
 
 import os
 import threading
+import warnings
 
 import numpy as np
 
-from ..errors import InputError, NotEnoughMemory
+from ..errors import InputError, NotEnoughMemory, OrientationWarning
 from .formats import NPY_DTYPES, READ_FORMATS, import_codec
-from .limits import check_decoded_size
-from .orientation import apply_orientation, png_header, tiff_orientation
+from .limits import DECLARED_ONLY, Declared, check_decoded_size
+from .orientation import ORIENTATION_NAMES, apply_orientation, png_header, tiff_orientation
 
-__all__ = ["read_image", "orientation_tag"]
+__all__ = ["read_image", "declared_image", "orientation_tag", "describe_orientations", "warn_if_orientations_differ"]
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 _TIFF_SIGNATURES = (b"II*\x00", b"MM\x00*", b"II+\x00", b"MM\x00+")
@@ -100,6 +101,51 @@ def orientation_tag(path):
             return int(image.getexif().get(0x0112, 1))
     except (InputError, OSError, ValueError, TypeError):
         return 1
+
+
+def declared_image(path):
+    """The shape and dtype :func:`read_image` would decode `path` to, from its header alone.
+
+    Returns
+    -------
+    shape : tuple of int
+    dtype : numpy.dtype
+
+    Raises
+    ------
+    InputError
+        As :func:`read_image` does for a file it cannot read.
+    """
+    try:
+        # Each reader reports its header's figures to check_decoded_size before decoding.
+        image = read_image(path, max_bytes=DECLARED_ONLY)
+    except Declared as declared:
+        return declared.shape, declared.dtype
+    return image.shape, image.dtype  # a reader that checks no size (an .npy of another rank)
+
+
+def describe_orientations(paths):
+    """How the files `paths` (ORIGINAL, FILTERED) declare different orientations, or None when
+    they declare the same (for messages: a reader has applied each)."""
+    tags = [orientation_tag(path) for path in paths]
+    if tags[0] == tags[1]:
+        return None
+    return " but ".join(f"{role} is tagged orientation {tag} ({ORIENTATION_NAMES.get(tag, 'unknown')} for display)"
+                        for role, tag in zip(("ORIGINAL", "FILTERED"), tags))
+
+
+def warn_if_orientations_differ(original, filtered, name=None):
+    """Warn (:class:`OrientationWarning`, one line) when two files declare different orientations.
+
+    Called once the pair's sizes match: a square pair then reads the same size however it is
+    turned, and a program that dropped the tag without turning the pixels leaves F misaligned.
+    """
+    described = describe_orientations((original, filtered))
+    if described is not None:
+        warnings.warn(f"{name + ': ' if name else ''}the files' orientation tags differ: {described}; each is "
+                      "turned upright as tagged, so if a program dropped or changed a tag without turning the "
+                      "pixels the pair is misaligned and the repair is wrong: check that both look the same "
+                      "way up", OrientationWarning, stacklevel=2)
 
 
 def _opened(path):
