@@ -16,6 +16,7 @@ from .. import __version__
 from ..errors import AarecoveryWarning, InputError, NotEnoughMemory
 from ..extras import extra_for, missing_extra
 from ..gimp import cli as gimp_command
+from ..krita import cli as krita_command
 from ..viewer import cli as view_command
 from . import batch as batch_command
 from . import bench as bench_command
@@ -28,7 +29,7 @@ __all__ = ["main", "build_parser"]
 
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMANDS = (recover_command, batch_command, bench_command, filters_command, eval_command, demo_command, gimp_command,
-            view_command)
+            krita_command, view_command)
 
 _EPILOG = """\
 examples:
