@@ -86,15 +86,16 @@ def run_case(krita, case, out, repair):
                 fh.write(bytes(doc.selection().pixelData(0, 0, w, h)))
         before = {n.uniqueId() for n in doc.rootNode().childNodes()}
         try:
-            outcome = repair.repair(doc, target, case["entry"], case["settings"])
+            repaired, outcome = repair.repair(doc, target, case["entry"], case["settings"])
         except repair.PluginError as error:
             record.update(status="error", message=str(error))
         else:
             record.update(status="success", backend=outcome.backend, runner=outcome.runner,
                           summary=outcome.summary, alerts=outcome.alerts, notes=outcome.notes,
-                          aarecovery_path=outcome.folders["aarecovery"], depth_after=target.colorDepth(),
-                          model_after=target.colorModel())
-            export(target, doc, os.path.join(out, f"{name}-R.raw"))
+                          aarecovery_path=outcome.folders["aarecovery"], depth_after=repaired.colorDepth(),
+                          model_after=repaired.colorModel())
+            export(repaired, doc, os.path.join(out, f"{name}-R.raw"))
+            export(target, doc, os.path.join(out, f"{name}-T.raw"))          # the layer it read
         # What the plug-in added (Krita adds the selection's own mask node by itself).
         record["added_layers"] = [(n.name(), n.visible()) for n in doc.rootNode().childNodes()
                                   if n.uniqueId() not in before and n.type() != "selectionmask"]

@@ -4,8 +4,9 @@ test_krita_gui.py installs it as ``aarecovery_gui_check`` beside the real plug-i
 both in a throwaway kritarc. When Krita's window is up it: lists the menu entries whose text
 names antialiasing; opens a document with the test's O (below) and F (above, active); triggers
 the action ``aarecovery_from_layer`` exactly as the menu does, which shows the plug-in's dialog;
-grabs the screen with the dialog open (``dialog.png``) and presses OK; exports the repaired
-layer (``R.raw``) and grabs the screen again (``result.png``); writes ``gui.json`` and quits.
+grabs the screen with the dialog open (``dialog.png``) and presses OK; exports the new
+repaired layer (``R.raw``) and grabs the screen again (``result.png``); presses Edit > Undo once and
+exports the filtered layer (``U.raw``); writes ``gui.json`` and quits.
 Any other modal window (an error box) is recorded, closed, and ends the run.
 
 Paths come from ``$AARECOVERY_KRITA_GUI`` (a folder with ``case.json``, ``O.raw``, ``F.raw``).
@@ -119,14 +120,25 @@ class GuiCheck(Extension):
             self.record["modal"].append(stray.text() if hasattr(stray, "text") else stray.windowTitle())
             stray.close()
 
+    def export(self, node, name):
+        with open(os.path.join(FOLDER, name), "wb") as fh:
+            fh.write(bytes(node.pixelData(0, 0, self.doc.width(), self.doc.height())))
+
     @step
     def finish(self):
-        w, h = self.doc.width(), self.doc.height()
-        with open(os.path.join(FOLDER, "R.raw"), "wb") as fh:
-            fh.write(bytes(self.layer.pixelData(0, 0, w, h)))
+        self.export(self.doc.nodeByName("filtered (repaired)"), "R.raw")
         self.record["layers"] = [(n.name(), n.visible()) for n in self.doc.rootNode().childNodes()
                                  if n.type() == "paintlayer"]
         self.grab("result.png")
+        # What Edit > Undo does after the repair (docs/krita.md says what Krita's API allows).
+        Krita.instance().action("edit_undo").trigger()
+        QTimer.singleShot(1000, self.after_undo)
+
+    @step
+    def after_undo(self):
+        self.export(self.layer, "U.raw")
+        self.record["layers_after_undo"] = [n.name() for n in self.doc.rootNode().childNodes()
+                                            if n.type() == "paintlayer"]
         self.save()
         self.doc.setModified(False)
         QApplication.quit()

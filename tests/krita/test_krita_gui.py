@@ -105,6 +105,14 @@ def test_menu_entry_repairs_the_layer_like_recover(gui_run):
     error = np.abs(recovered - expected).max()
     assert error <= TOLERANCE, f"max difference {error * 255:.3f}/255 from aarecovery.recover"
     assert np.abs(recovered - filtered).max() > 0.05
-    assert ["filtered (before repair)", False] in record["layers"], record
+    assert record["layers"] == [["original", True], ["filtered", True], ["filtered (repaired)", True]], record
     for name in ("dialog.png", "result.png"):
         assert (folder / name).stat().st_size > 10_000, name
+
+
+def test_one_undo_takes_the_repair_back(gui_run):
+    # Krita's Python writes pixels outside the undo history; the repaired layer is one step.
+    record, folder = gui_run["record"], gui_run["folder"]
+    filtered, undone = (decode(folder / f"{k}.raw", "U8", (120, 168)) for k in "FU")
+    assert record["layers_after_undo"] == ["original", "filtered"], record
+    assert np.array_equal(undone, filtered)

@@ -40,7 +40,6 @@ STORED = {"U8": (("Blue", "Green", "Red", "Alpha"), "<u1"), "U16": (("Blue", "Gr
 CORE_ORDER = ("Red", "Green", "Blue", "Alpha")
 GRADIENT = ('<gradient type="stop"><stop offset="0" bitdepth="U8" alpha="1"><sRGB r="0.1" g="0.05" b="0.4"/>'
             '</stop><stop offset="1" bitdepth="U8" alpha="1"><sRGB r="1" g="0.85" b="0.2"/></stop></gradient>')
-BEFORE = "original (before repair)"
 
 
 def missing_krita():
@@ -192,9 +191,11 @@ def check_case(run, name):
     assert result["summary"].startswith(("repaired ", "returned F unchanged")), result
     if not case.get("smooth"):                     # the test must be able to fail
         assert np.abs(recovered - filtered).max() > 0.05, f"{name}: the result equals the filtered input"
-    # No undo step from Krita's Python: the layer as it was is kept, hidden, above it.
+    # The repair is a new layer above (one undoable step); the layer it read is as it was.
     target = "original" if case["entry"] == "apply-filter" else "filtered"
-    assert result["added_layers"] == [[f"{target} (before repair)", False]], result
+    assert result["added_layers"] == [[f"{target} (repaired)", True]], result
+    assert np.array_equal(decode(folder / f"{name}-T.raw", depth, shape), original if target == "original" else
+                          decode(folder / f"{name}-F.raw", depth, shape)), f"{name}: the layer read was changed"
     return result, error
 
 

@@ -36,7 +36,7 @@ class RepairExtension(Extension):
             settings = dialog.ask(krita, entry, parent)
             if settings is None:
                 return
-            outcome = repair(doc, doc.activeNode(), entry, settings)
+            _, outcome = repair(doc, doc.activeNode(), entry, settings)
         except PluginError as error:
             QMessageBox.warning(parent, "Repair antialiasing", str(error))
             return

@@ -1,8 +1,8 @@
 """The work of both menu entries, without any dialog: what the tests drive inside Krita.
 
 :func:`repair` takes a document, its active paint layer and the settings (the dialog's values),
-reads O and F as float32, runs the core through ``aarecovery_bridge`` and writes the result
-back into the layer in its own colour model and depth, blended by the selection.
+reads O and F as float32, runs the core through ``aarecovery_bridge`` and writes the result,
+blended by the selection, into a new layer above in the layer's own colour model and depth.
 """
 
 from aarecovery_bridge import PluginError, check_version, filters, parameters, worker
@@ -14,8 +14,8 @@ FROM_LAYER, APPLY_FILTER = "from-layer", "apply-filter"
 #: The dialog's values when nothing was chosen: the core's defaults, the first filter.
 DEFAULTS = {**{row[0]: row[5] for row in parameters.RECOVERY_ARGUMENTS if row[5] is not None},
             "auto-strength": True, "strength": 1.0, "backend": "auto", "python": "",
-            "filter": next(iter(filters.KRITA_FILTERS)), "properties": "", "keep-copy": True}
-BEFORE_SUFFIX = " (before repair)"
+            "filter": next(iter(filters.KRITA_FILTERS)), "properties": ""}
+REPAIRED_SUFFIX = " (repaired)"
 
 
 def paint_layer(node, role="the active layer"):
@@ -49,8 +49,8 @@ def read(node, doc, layout):
     return to_float(bytes(node.pixelData(0, 0, doc.width(), doc.height())), layout)
 
 
-def run_filter(node, doc, key, text):
-    """Apply Krita's own filter `key` of the catalogue, configured by `text`, to `node`."""
+def configured_filter(key, text):
+    """Krita's own filter `key` of the catalogue, configured by the ``name=value`` `text`."""
     from krita import Krita
     filter_id, label, default = filters.KRITA_FILTERS[key]
     host_filter = Krita.instance().filter(filter_id)
@@ -63,21 +63,25 @@ def run_filter(node, doc, key, text):
             raise PluginError(f"{label} has no property '{name}'; it has: {', '.join(sorted(known))}")
         config.setProperty(name, filters.convert_like(name, value, known[name]))
     host_filter.setConfiguration(config)
-    host_filter.apply(node, 0, 0, doc.width(), doc.height())
-    doc.waitForDone()
+    return host_filter
 
 
-def copy_of(node):
-    """The layer as it is, hidden, named for what it holds: Krita 5's Python API gives pixel
-    writes no undo step, so the plug-in keeps this above the layer it repaired."""
+def repaired_layer(node):
+    """A copy of `node` above it, named for what it will hold.
+
+    Krita 5's Python API writes pixels outside the undo history (``Node.setPixelData``;
+    measured in tests/krita/test_krita_gui.py), but adding a layer is one undoable step: so
+    the repair goes into this new layer and `node` is never written, and one Edit > Undo
+    takes the whole repair back.
+    """
     copy = node.duplicate()
-    copy.setName(node.name() + BEFORE_SUFFIX)
-    copy.setVisible(False)
+    copy.setName(node.name() + REPAIRED_SUFFIX)
+    node.parentNode().addChildNode(copy, node)
     return copy
 
 
 def repair(doc, node, entry, settings):
-    """Repair `node` of `doc`; return the :class:`aarecovery_bridge.worker.Outcome`.
+    """Repair `node` of `doc` into a new layer above it; return ``(that layer, outcome)``.
 
     Parameters
     ----------
@@ -86,6 +90,11 @@ def repair(doc, node, entry, settings):
         filter ``settings["filter"]`` with ``settings["properties"]`` makes F).
     settings : dict
         The dialog's values; missing ones take :data:`DEFAULTS`.
+
+    Returns
+    -------
+    (krita.Node, aarecovery_bridge.worker.Outcome)
+        The new layer, in `node`'s colour model and depth, and what the recovery did.
     """
     check_version(AARECOVERY_VERSION, __file__, "aarecovery krita install")
     settings = {**DEFAULTS, **settings}
@@ -105,23 +114,22 @@ def repair(doc, node, entry, settings):
         original, filtered = read(source, doc, source_layout), read(node, doc, layout)
         o_shape, before = shape[:2] + (source_layout.channels,), filtered
     else:
-        stored = bytes(node.pixelData(0, 0, doc.width(), doc.height()))
-        original, o_shape = to_float(stored, layout), shape
-        before = original
-    backup = copy_of(node) if settings["keep-copy"] else None
+        original = before = read(node, doc, layout)
+        o_shape = shape
+        host_filter = configured_filter(settings["filter"], settings["properties"])   # typos fail here
+    target = repaired_layer(node)
     try:
         if entry == APPLY_FILTER:
-            run_filter(node, doc, settings["filter"], settings["properties"])
-            filtered = read(node, doc, layout)
+            host_filter.apply(target, 0, 0, doc.width(), doc.height())
+            doc.waitForDone()
+            filtered = read(target, doc, layout)
         outcome = worker.run_core(HOST, (original, o_shape), (filtered, shape), params,
                                   settings["python"], BUNDLE_NOTE)
     except BaseException:
-        if entry == APPLY_FILTER:                # the filter ran: put the layer back as it was
-            node.setPixelData(stored, 0, 0, doc.width(), doc.height())
+        target.remove()
         raise
     result = outcome.data if mask is None else blend(before, outcome.data, mask, layout.channels)
-    node.setPixelData(from_float(result, layout), 0, 0, doc.width(), doc.height())
-    if backup is not None:
-        node.parentNode().addChildNode(backup, node)
+    target.setPixelData(from_float(result, layout), 0, 0, doc.width(), doc.height())
+    doc.setActiveNode(target)
     doc.refreshProjection()
-    return outcome
+    return target, outcome
