@@ -56,8 +56,8 @@ GIMP_COLOUR_TOOLS = {
 KRITA_FILTERS = {
     "threshold": ("threshold", "Threshold", "threshold=128"),
     "posterize": ("posterize", "Posterize", "steps=4"),
-    "gradientmap": ("gradientmap", "Gradient Map (foreground to background)", ""),
-    "levels": ("levels", "Levels", ""),
+    # Empty: Krita's default gradient; gradientXML='<gradient type="stop">...' sets another.
+    "gradientmap": ("gradientmap", "Gradient Map", ""),
     "indexcolors": ("indexcolors", "Index Colors", ""),
     "palettize": ("palettize", "Palettize", ""),
     "desaturate": ("desaturate", "Desaturate", ""),

@@ -13,6 +13,7 @@ Krita's Python imports the plug-in from the resource folder the test installed i
 first, so that Krita's Python can import aarecovery in process.
 """
 
+import importlib.util
 import json
 import os
 import site
@@ -51,12 +52,13 @@ def run_case(krita, case, out, repair):
     from krita import Selection
     name, (w, h) = case["name"], case["size"]
     read = lambda suffix: open(os.path.join(out, f"{name}-{suffix}.raw"), "rb").read()  # noqa: E731
-    doc = krita.createDocument(w, h, name, "RGBA", case["depth"], "", 72.0)
+    doc = krita.createDocument(w, h, name, case.get("model", "RGBA"), case["depth"], "", 72.0)
     try:
         for default in doc.rootNode().childNodes():        # createDocument's "Background"
             default.remove()
         original = layer(doc, "original", read("in-O"))
         record = {"name": name, "depth": original.colorDepth(), "profile": original.colorProfile(),
+                  "numpy_in_krita": importlib.util.find_spec("numpy") is not None,
                   "channels": [c.name() for c in original.channels()]}
         export(original, doc, os.path.join(out, f"{name}-O.raw"))
         if case.get("alone"):

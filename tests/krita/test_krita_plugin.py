@@ -34,10 +34,13 @@ from scenes import disc_and_bar as scene  # noqa: E402
 HERE = Path(__file__).resolve().parent
 TOLERANCE = 1 / 255 + 1e-6
 SIGMAS = {"sigma-d": 0.1, "sigma-e": 0.01, "iterations": 3}
-# Krita's stored channel order per depth, and the dtype of one channel.
-STORED = {"U8": (("Blue", "Green", "Red", "Alpha"), "<u1"), "U16": (("Blue", "Green", "Red", "Alpha"), "<u2"),
-          "F32": (("Red", "Green", "Blue", "Alpha"), "<f4")}
-CORE_ORDER = ("Red", "Green", "Blue", "Alpha")
+# Krita's stored channel order per colour model and depth (what the driver reports is checked
+# against it), and the dtype of one channel per depth.
+STORED = {("RGBA", "U8"): ("Blue", "Green", "Red", "Alpha"), ("RGBA", "U16"): ("Blue", "Green", "Red", "Alpha"),
+          ("RGBA", "F16"): ("Red", "Green", "Blue", "Alpha"), ("RGBA", "F32"): ("Red", "Green", "Blue", "Alpha"),
+          ("GRAYA", "U8"): ("Gray", "Alpha")}
+DTYPES = {"U8": "<u1", "U16": "<u2", "F16": "<f2", "F32": "<f4"}
+CORE_ORDER = {"RGBA": ("Red", "Green", "Blue", "Alpha"), "GRAYA": ("Gray", "Alpha")}
 GRADIENT = ('<gradient type="stop"><stop offset="0" bitdepth="U8" alpha="1"><sRGB r="0.1" g="0.05" b="0.4"/>'
             '</stop><stop offset="1" bitdepth="U8" alpha="1"><sRGB r="1" g="0.85" b="0.2"/></stop></gradient>')
 
@@ -49,26 +52,34 @@ def missing_krita():
             "sudo bash packaging/test.sh, or: sudo apt-get install krita python3-pyqt5")
 
 
-def encode(image, depth):
-    """float RGBA (H, W, 4) -> Krita's stored bytes for `depth`."""
-    order, dtype = STORED[depth]
-    stored = image[..., [CORE_ORDER.index(name) for name in order]]
-    if dtype != "<f4":
+def as_model(rgba, model):
+    if model == "RGBA":
+        return rgba
+    return np.stack([rgba[..., :3] @ np.array([0.2126, 0.7152, 0.0722]), rgba[..., 3]], -1)
+
+
+def encode(image, depth, model="RGBA"):
+    """float (H, W, C) in the core's order -> Krita's stored bytes for `model` and `depth`."""
+    order, dtype = STORED[model, depth], DTYPES[depth]
+    stored = image[..., [CORE_ORDER[model].index(name) for name in order]]
+    if dtype.startswith("<u"):
         stored = np.round(np.clip(stored, 0, 1) * np.iinfo(dtype).max)
     return stored.astype(dtype).tobytes()
 
 
-def decode(path, depth, shape):
-    order, dtype = STORED[depth]
-    stored = np.frombuffer(Path(path).read_bytes(), dtype=dtype).reshape(shape[0], shape[1], 4).astype(np.float64)
-    if dtype != "<f4":
+def decode(path, depth, shape, model="RGBA"):
+    order, dtype = STORED[model, depth], DTYPES[depth]
+    stored = np.frombuffer(Path(path).read_bytes(), dtype=dtype).reshape(shape[0], shape[1], len(order))
+    stored = stored.astype(np.float64)
+    if dtype.startswith("<u"):
         stored /= np.iinfo(dtype).max
-    return stored[..., [order.index(name) for name in CORE_ORDER]]
+    return stored[..., [order.index(name) for name in CORE_ORDER[model]]]
 
 
 def threshold(image):
+    """Colour channels (all but the last, alpha) at 0.5."""
     out = image.copy()
-    out[..., :3] = image[..., :3] >= 0.5
+    out[..., :-1] = image[..., :-1] >= 0.5
     return out
 
 
@@ -76,12 +87,12 @@ def build_cases(folder):
     rgba = scene()
     h, w = rgba.shape[:2]
 
-    def case(name, entry, depth="U8", settings=None, filtered=None, **extra):
-        (folder / f"{name}-in-O.raw").write_bytes(encode(rgba, depth))
+    def case(name, entry, depth="U8", settings=None, model="RGBA", **extra):
+        image = as_model(rgba, model)
+        (folder / f"{name}-in-O.raw").write_bytes(encode(image, depth, model))
         if entry == "from-layer":
-            (folder / f"{name}-in-F.raw").write_bytes(encode(filtered if filtered is not None else threshold(rgba),
-                                                             depth))
-        return {"name": name, "entry": entry, "depth": depth, "size": [w, h],
+            (folder / f"{name}-in-F.raw").write_bytes(encode(threshold(image), depth, model))
+        return {"name": name, "entry": entry, "depth": depth, "model": model, "size": [w, h],
                 "settings": {**SIGMAS, **(settings or {})}, **extra}
 
     def filtered_by(name, filter_key, props_text, props, depth="U8", **extra):
@@ -94,6 +105,9 @@ def build_cases(folder):
         filtered_by("filter-posterize-u8", "posterize", "steps=3", {"steps": 3}),
         filtered_by("filter-gradientmap-u8", "gradientmap", f"gradientXML='{GRADIENT}'", {"gradientXML": GRADIENT},
                     smooth=True),
+        filtered_by("filter-indexcolors-u8", "indexcolors", "", {}),
+        filtered_by("filter-palettize-u8", "palettize", "", {}),
+        filtered_by("filter-desaturate-u8", "desaturate", "", {}, smooth=True),
         filtered_by("filter-threshold-u16", "threshold", "threshold=128", {"threshold": 128}, depth="U16"),
         filtered_by("filter-threshold-f32", "threshold", "threshold=128", {"threshold": 128}, depth="F32"),
         filtered_by("filter-threshold-u8-selection", "threshold", "threshold=128", {"threshold": 128},
@@ -101,6 +115,8 @@ def build_cases(folder):
         case("layer-u8", "from-layer"),
         case("layer-u8-selection", "from-layer", selection=feathered),
         case("layer-u16", "from-layer", depth="U16"),
+        case("layer-f16", "from-layer", depth="F16"),
+        filtered_by("filter-threshold-graya8", "threshold", "threshold=128", {"threshold": 128}, model="GRAYA"),
         case("error-group", "from-layer", group=True, expect="group layer"),
         case("error-offset", "from-layer", offset=[3, 2], expect="same size and position"),
         case("error-no-layer-below", "from-layer", alone=True, expect="no layer below"),
@@ -108,7 +124,8 @@ def build_cases(folder):
     ]
 
 
-OUT_OF_PROCESS = ("filter-threshold-u8", "layer-u8-selection", "filter-threshold-f32", "error-offset")
+OUT_OF_PROCESS = ("filter-threshold-u8", "layer-u8-selection", "filter-threshold-f32", "layer-u16", "layer-f16",
+                  "filter-threshold-graya8", "error-offset")
 
 
 def krita_run(workdir, mode, cases, pykrita, env, screenshot=None):
@@ -167,12 +184,12 @@ def krita_runs(tmp_path_factory):
 def check_case(run, name):
     case, result = run["cases"][name], run["results"][name]
     assert result["status"] == "success", f"{name}: {result}"
-    depth = case["depth"]
-    assert result["channels"] == list(STORED[depth][0]), result     # the layout the test assumes
-    assert (result["depth_after"], result["model_after"]) == (depth, "RGBA"), result
+    depth, model = case["depth"], case["model"]
+    assert result["channels"] == list(STORED[model, depth]), result     # the layout the test assumes
+    assert (result["depth_after"], result["model_after"]) == (depth, model), result
     shape = case["size"][::-1]
     folder = run["dir"]
-    original, filtered, recovered = (decode(folder / f"{name}-{k}.raw", depth, shape) for k in "OFR")
+    original, filtered, recovered = (decode(folder / f"{name}-{k}.raw", depth, shape, model) for k in "OFR")
     linear = "g10" in result["profile"]
     assert linear == (depth != "U8"), result["profile"]      # Krita's defaults: sRGB TRC for 8-bit only
     if case["entry"] == "apply-filter":
@@ -194,13 +211,15 @@ def check_case(run, name):
     # The repair is a new layer above (one undoable step); the layer it read is as it was.
     target = "original" if case["entry"] == "apply-filter" else "filtered"
     assert result["added_layers"] == [[f"{target} (repaired)", True]], result
-    assert np.array_equal(decode(folder / f"{name}-T.raw", depth, shape), original if target == "original" else
-                          decode(folder / f"{name}-F.raw", depth, shape)), f"{name}: the layer read was changed"
+    assert np.array_equal(decode(folder / f"{name}-T.raw", depth, shape, model), original if target == "original"
+                          else decode(folder / f"{name}-F.raw", depth, shape, model)), f"{name}: the layer read changed"
     return result, error
 
 
-IN_PROCESS = ("filter-threshold-u8", "filter-posterize-u8", "filter-gradientmap-u8", "filter-threshold-u16",
-              "filter-threshold-f32", "filter-threshold-u8-selection", "layer-u8", "layer-u8-selection", "layer-u16")
+IN_PROCESS = ("filter-threshold-u8", "filter-posterize-u8", "filter-gradientmap-u8", "filter-indexcolors-u8",
+              "filter-palettize-u8", "filter-desaturate-u8", "filter-threshold-u16",
+              "filter-threshold-f32", "filter-threshold-u8-selection", "layer-u8", "layer-u8-selection", "layer-u16",
+              "layer-f16", "filter-threshold-graya8")
 
 
 @pytest.mark.parametrize("name", IN_PROCESS)
@@ -214,6 +233,8 @@ def test_in_process_equals_recover(krita_runs, name):
 def test_out_of_process_equals_recover(krita_runs, name):
     result, _ = check_case(krita_runs["subprocess"], name)
     assert result["runner"] == "subprocess", result
+    # Krita's Python has no NumPy here: the pixels went through the standard-library codec.
+    assert not result["numpy_in_krita"], result
     assert result["aarecovery_path"] != "", result
 
 
