@@ -55,6 +55,8 @@ class Host:
         Where the dialog takes a Python with aarecovery, in the host's words.
     force_hint : str
         How the summary tells the user to force a repair.
+    bundles : bool
+        Whether ``install --bundle`` exists for this host.
     """
 
     name: str
@@ -62,6 +64,7 @@ class Host:
     folder: str
     python_field: str
     force_hint: str
+    bundles: bool = True
 
     @property
     def bundle_dir(self):
@@ -258,13 +261,13 @@ def run_core(host, original, filtered, params, python="", bundle_note=None):
     if not chosen:
         if bundled:
             raise PluginError(notes[-1])
+        bundle = f"run '{host.command} install --bundle', or " if host.bundles else ""
         raise PluginError(
             f"{host.name}'s Python ({sys.executable}, {sys.version.split()[0]}) cannot import "
             f"aarecovery ({import_error}) and no Python with aarecovery is configured"
-            + (f" ({bundle_note})" if bundle_note else "") + f". Either run '{host.command} "
-            f"install --bundle', or run '{host.command} install' from a Python that has "
-            "aarecovery, set the environment variable AARECOVERY_PYTHON, or enter that Python "
-            f"in {host.python_field}.")
+            + (f" ({bundle_note})" if bundle_note else "") + f". Either {bundle}run '{host.command} "
+            "install' from a Python that has aarecovery, set the environment variable AARECOVERY_PYTHON, "
+            f"or enter that Python in {host.python_field}.")
     return _run_worker(host, chosen, original, filtered, params, notes)
 
 

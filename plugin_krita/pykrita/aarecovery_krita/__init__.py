@@ -14,9 +14,7 @@ from aarecovery_bridge import worker
 AARECOVERY_VERSION = "0.1.0"          # aarecovery_bridge must be the same release
 HOST = worker.Host("Krita", "aarecovery krita", os.path.dirname(os.path.abspath(__file__)),
                    "the dialog's 'Python with aarecovery' field",
-                   "the dialog's Strength with Automatic strength unticked")
-# Before anything imports NumPy: a bundle made for this Python shadows the system's.
-BUNDLE_NOTE = worker.use_bundle(HOST)
+                   "the dialog's Strength with Automatic strength unticked", bundles=False)
 
 try:
     from krita import Krita

@@ -7,7 +7,7 @@ blended by the selection, into a new layer above in the layer's own colour model
 
 from aarecovery_bridge import PluginError, check_version, filters, parameters, worker
 
-from . import AARECOVERY_VERSION, BUNDLE_NOTE, HOST
+from . import AARECOVERY_VERSION, HOST
 from .pixels import blend, from_float, layout_of, to_float
 
 FROM_LAYER, APPLY_FILTER = "from-layer", "apply-filter"
@@ -123,8 +123,7 @@ def repair(doc, node, entry, settings):
             host_filter.apply(target, 0, 0, doc.width(), doc.height())
             doc.waitForDone()
             filtered = read(target, doc, layout)
-        outcome = worker.run_core(HOST, (original, o_shape), (filtered, shape), params,
-                                  settings["python"], BUNDLE_NOTE)
+        outcome = worker.run_core(HOST, (original, o_shape), (filtered, shape), params, settings["python"])
     except BaseException:
         target.remove()
         raise

@@ -90,3 +90,24 @@ def test_unwritable_folder_is_one_line(tmp_path, capsys):
     assert krita_main(["install", "--resource-dir", str(tmp_path / "file" / "krita")]) == 1
     err = capsys.readouterr().err
     assert err.startswith("aarecovery: error: cannot write to") and err.count("\n") == 1, err
+
+
+def test_a_host_python_without_the_core_is_told_what_to_do(tmp_path):
+    """What a host's Python without NumPy or aarecovery, and no worker Python, says; per host."""
+    import subprocess
+    profile = inst.Profile("custom", tmp_path / "krita")
+    inst.install(profile)
+    probe = ("import sys; sys.path.insert(0, sys.argv[1]); sys.modules['numpy'] = None\n"
+             "from aarecovery_bridge import PluginError, worker\n"
+             "for bundles in (True, False):\n"
+             "    host = worker.Host('Krita', 'aarecovery krita', sys.argv[2], 'the dialog', '', bundles)\n"
+             "    try:\n"
+             "        worker.run_core(host, (b'', (0, 0, 4)), (b'', (0, 0, 4)), {})\n"
+             "    except PluginError as error:\n"
+             "        print(error)\n")
+    proc = subprocess.run([sys.executable, "-I", "-S", "-c", probe, str(profile.pykrita),
+                           str(tmp_path / "nowhere")], capture_output=True, text=True, env={"PATH": "/usr/bin:/bin"})
+    with_bundle, without = proc.stdout.strip().splitlines()
+    assert "Krita's Python" in without and "cannot import aarecovery" in without, proc.stderr
+    assert "install --bundle" in with_bundle and "--bundle" not in without
+    assert "AARECOVERY_PYTHON" in without and "enter that Python in the dialog" in without
