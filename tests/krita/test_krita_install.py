@@ -65,6 +65,9 @@ def test_install_status_remove(tmp_path, capsys):
     bridge = {rel.name: source for rel, source in inst.plugin_files() if rel.parts[0] == "aarecovery_bridge"}
     assert bridge == {rel.name: source for rel, source in gimp_install.plugin_files()
                       if rel.parts[0] == "aarecovery_bridge"}
+    # The plug-in checks at run time that its aarecovery_bridge is of its own release.
+    plugin = (pykrita / "aarecovery_krita" / "__init__.py").read_text()
+    assert f'AARECOVERY_VERSION = "{aarecovery.__version__}"' in plugin
     config = json.loads((pykrita / "aarecovery_krita" / "config.json").read_text())
     assert config == {"python": sys.executable, "aarecovery_version": aarecovery.__version__}
     assert inst.is_enabled(tmp_path / "kritarc")

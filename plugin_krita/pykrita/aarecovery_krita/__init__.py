@@ -16,12 +16,8 @@ HOST = worker.Host("Krita", "aarecovery krita", os.path.dirname(os.path.abspath(
                    "the dialog's 'Python with aarecovery' field",
                    "the dialog's Strength with Automatic strength unticked", bundles=False)
 
-try:
-    from krita import Krita
-except ImportError:                   # imported outside Krita (the installer's checks)
-    Krita = None
+from krita import Krita  # noqa: E402  (the modules below import HOST from here)
 
-if Krita is not None:
-    from .extension import RepairExtension
+from .extension import RepairExtension  # noqa: E402
 
-    Krita.instance().addExtension(RepairExtension(Krita.instance()))
+Krita.instance().addExtension(RepairExtension(Krita.instance()))
