@@ -17,11 +17,13 @@ AARECOVERY_VERSION = "0.1.0"          # aarecovery_bridge must be the same relea
 PLUGIN = "aarecovery-gimp"
 PROC_FILTER = "plug-in-aarecovery-apply-filter"
 PROC_LAYER = "plug-in-aarecovery-from-layer"
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
+HERE = os.path.dirname(os.path.abspath(__file__))   # first on sys.path: aarecovery_bridge is here
 
 from aarecovery_bridge import PluginError, check_version  # noqa: E402
 from aarecovery_bridge import filters, parameters, worker  # noqa: E402
+
+if __name__ == "__main__" and sys.argv[1:2] == ["--worker"]:     # O.npy F.npy R.npy PARAMS.json
+    sys.exit(worker.worker_main(sys.argv[2:]))
 
 HOST = worker.Host("GIMP", "aarecovery gimp", HERE, "the plug-in's 'Python with aarecovery' field",
                    "the dialog's Strength with Automatic strength unticked (auto-strength=FALSE, strength=1)")
