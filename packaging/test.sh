@@ -6,7 +6,8 @@
 # As root it installs the Debian packages the tests drive for real (Mesa's EGL/llvmpipe for
 # the GL backend, Xvfb for the viewer window, gegl and gmic for the eval's peer tools and,
 # with imagemagick and the DejaVu fonts, its real-tools suite (imagemagick and gmic also for
-# the batch's filter commands), debootstrap for the GIMP 3 sandbox) and builds or refreshes
+# the batch's filter commands), debootstrap for the GIMP 3 sandbox, Krita 5 with PyQt5 for the
+# Krita plug-in's tests, about 300 MB) and builds or refreshes
 # the GIMP 3 sandbox (a Debian trixie root, cached outside the checkout). Without root it
 # installs nothing system-wide and
 # says loudly what is missing; the tests that need it then fail in CI or skip with a message.
@@ -15,7 +16,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 DEBIAN_PACKAGES=(libegl1 libgl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth gegl gmic imagemagick fonts-dejavu-core
-                 debootstrap)
+                 debootstrap krita python3-pyqt5)
 
 missing=()
 for package in "${DEBIAN_PACKAGES[@]}"; do

@@ -67,7 +67,7 @@ def core_files():
     """
     import aarecovery
     left_out = []
-    for name in ("aarecovery.viewer", "aarecovery.gimp"):
+    for name in ("aarecovery.viewer", "aarecovery.gimp", "aarecovery.krita"):
         spec = importlib.util.find_spec(name)
         if spec is not None:
             left_out += [Path(p).resolve() for p in spec.submodule_search_locations or []]

@@ -28,8 +28,8 @@ from pathlib import Path
 from . import InstallError, bundle
 from .profiles import gimp_dir
 
-__all__ = ["PLUGIN_NAME", "BUNDLE_FOLDER", "plugin_source", "stage", "install", "uninstall",
-           "status"]
+__all__ = ["PLUGIN_NAME", "BUNDLE_FOLDER", "plugin_source", "plugin_files", "stage", "install",
+           "uninstall", "status"]
 
 PLUGIN_NAME = "aarecovery-gimp"
 BUNDLE_FOLDER = "site-packages"           # the plug-in script looks for this name
@@ -38,6 +38,19 @@ BUNDLE_FOLDER = "site-packages"           # the plug-in script looks for this na
 def plugin_source():
     """Path of the plug-in script shipped inside this package."""
     return Path(str(resources.files(__package__) / PLUGIN_NAME / f"{PLUGIN_NAME}.py"))
+
+
+def plugin_files():
+    """``(path inside the plug-in folder, source)`` of every file the plug-in runs.
+
+    The script and its GIMP filter module, and the host-neutral ``aarecovery_bridge`` that the
+    Krita plug-in installs too (one copy of each in the repository).
+    """
+    import aarecovery_bridge
+    script_dir = plugin_source().parent
+    files = [(Path(path.name), Path(path)) for path in sorted(script_dir.glob("*.py"))]
+    return files + [(Path("aarecovery_bridge", name), Path(path))
+                    for name, path in aarecovery_bridge.module_files()]
 
 
 def _target(plugins_dir):
@@ -65,8 +78,10 @@ def stage(folder, python, target=None, wheel_dir=None, log=print):
     from aarecovery import __version__
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
+    for rel, source in plugin_files():
+        (folder / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(source, folder / rel)
     script = folder / f"{PLUGIN_NAME}.py"
-    shutil.copyfile(plugin_source(), script)
     # GIMP ignores a plug-in it cannot execute, silently: set the mode explicitly.
     script.chmod(0o755)
     config = {"python": python, "aarecovery_version": __version__}
@@ -196,7 +211,8 @@ def status(plugins_dir=None, gimp_target=None):
     if not info["executable"]:
         info["problems"].append(f"{script} is not executable, so GIMP skips it; "
                                 "run: aarecovery gimp install")
-    info["current"] = script.read_bytes() == plugin_source().read_bytes()
+    info["current"] = all((folder / rel).is_file() and (folder / rel).read_bytes() == source.read_bytes()
+                          for rel, source in plugin_files())
     if not info["current"]:
         info["problems"].append("the installed plug-in differs from this aarecovery's; "
                                 "run: aarecovery gimp install")

@@ -70,7 +70,7 @@ def test_layers_table_names_every_command_and_the_recipe_holds():
 def test_files_the_architecture_names_exist():
     # Rows name files relative to their folder (`numpy.py` in backends/): a name must end the
     # path of some file of the checkout.
-    files = ["/" + path.relative_to(CHECKOUT).as_posix() for folder in ("core", "viewer", "plugin_gimp", "tests", "docs")
+    files = ["/" + path.relative_to(CHECKOUT).as_posix() for folder in ("core", "viewer", "plugin_gimp", "plugin_krita", "plugin_bridge", "tests", "docs")
              for path in (CHECKOUT / folder).rglob("*") if path.is_file()]
     named = set(re.findall(r"`([\w/]+\.(?:py|glsl|frag|md))`", ARCHITECTURE))
     missing = sorted(name for name in named if not any(path.endswith("/" + name) for path in files))

@@ -17,7 +17,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 # Import name -> source folder, as pyproject.toml's package-dir maps them.
-FOLDERS = {"aarecovery": "core", "aarecovery/viewer": "viewer", "aarecovery/gimp": "plugin_gimp"}
+FOLDERS = {"aarecovery": "core", "aarecovery/viewer": "viewer", "aarecovery/gimp": "plugin_gimp",
+           "aarecovery/krita": "plugin_krita", "aarecovery_bridge": "plugin_bridge"}
 
 
 @pytest.fixture(scope="module")

@@ -17,7 +17,7 @@ from ..errors import AarecoveryWarning, InputError, NotEnoughMemory
 from ..extras import extra_for, missing_extra
 from ..gimp import cli as gimp_command
 from ..io import os_error_line
-from .text import printable
+from ..krita import cli as krita_command
 from ..viewer import cli as view_command
 from . import batch as batch_command
 from . import bench as bench_command
@@ -25,12 +25,13 @@ from . import demo as demo_command
 from . import eval as eval_command
 from . import filters as filters_command
 from . import recover as recover_command
+from .text import printable
 
 __all__ = ["main", "build_parser"]
 
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMANDS = (recover_command, batch_command, bench_command, filters_command, eval_command, demo_command, gimp_command,
-            view_command)
+            krita_command, view_command)
 
 _EPILOG = """\
 examples:

@@ -17,9 +17,11 @@ import numpy as np
 import pytest
 
 import aarecovery
+import aarecovery_bridge
 from aarecovery.cli import main
 from aarecovery.gimp import InstallError, gimp_python, profiles
 from aarecovery.gimp import install as inst
+from aarecovery_bridge import npy, parameters, worker
 
 CHECKOUT = Path(__file__).resolve().parents[2]
 
@@ -204,23 +206,6 @@ def test_flatpak_install_bundles_and_needs_flatpak_to_ask(tmp_path, monkeypatch,
     assert not (tmp_path / ".var").exists()
 
 
-def plugin_prelude(folder):
-    """Run the plug-in script up to its GIMP imports as if it were installed in `folder`.
-
-    That part decides whether the bundle is used (``use_bundle``); it needs no GIMP. Returns
-    its namespace and ``sys.path`` as it left it (``sys.path`` itself is restored).
-    """
-    source = inst.plugin_source().read_text(encoding="utf-8")
-    prelude = source[:source.index("\nimport gi ")]
-    namespace = {"__file__": str(folder / "aarecovery-gimp.py"), "__name__": "plugin_prelude"}
-    saved = list(sys.path)
-    try:
-        exec(compile(prelude, "aarecovery-gimp.py", "exec"), namespace)
-        return namespace, list(sys.path)
-    finally:
-        sys.path[:] = saved
-
-
 THIS_PYTHON = ("%d.%d" % sys.version_info[:2],
                re.sub(r"^macosx-[0-9.]+-", "macosx-", sysconfig.get_platform()))
 
@@ -233,14 +218,52 @@ def test_plugin_uses_only_a_bundle_made_for_its_python(tmp_path, python, platfor
     (tmp_path / "site-packages").mkdir()
     bundle = {"python": python, "platform": platform}
     (tmp_path / "config.json").write_text(json.dumps({"python": "", "bundle": bundle}))
-    namespace, path = plugin_prelude(tmp_path)
+    host = worker.Host("GIMP", "aarecovery gimp", str(tmp_path), "the dialog", "")
+    saved = list(sys.path)
+    try:
+        note = worker.use_bundle(host)
+        path = list(sys.path)
+    finally:
+        sys.path[:] = saved
     assert (path[0] == str(tmp_path / "site-packages")) == used
     if used:
-        assert namespace["BUNDLE_NOTE"] is None
+        assert note is None
     else:
-        assert f"are for CPython {python} on {platform}, but GIMP runs cpython" in \
-            namespace["BUNDLE_NOTE"]
-        assert "aarecovery gimp install --bundle" in namespace["BUNDLE_NOTE"]
+        assert f"are for CPython {python} on {platform}, but GIMP runs cpython" in note
+        assert "aarecovery gimp install --bundle" in note
+
+
+def test_installed_helpers_are_the_scripts_release_and_need_only_the_standard_library(tmp_path):
+    inst.install(tmp_path)
+    folder = tmp_path / inst.PLUGIN_NAME
+    script = (folder / f"{inst.PLUGIN_NAME}.py").read_text(encoding="utf-8")
+    assert f'AARECOVERY_VERSION = "{aarecovery.__version__}"' in script
+    assert aarecovery_bridge.__version__ == aarecovery.__version__
+    # A host's Python without NumPy (or anything of ours) imports every helper module.
+    probe = ("import sys; sys.path.insert(0, sys.argv[1]); sys.modules['numpy'] = None; "
+             "import aarecovery_bridge.worker, aarecovery_bridge.filters, aarecovery_bridge.npy, "
+             "aarecovery_bridge.parameters as p; print(aarecovery_bridge.__file__, len(p.RECOVERY_ARGUMENTS))")
+    proc = subprocess.run([sys.executable, "-I", "-S", "-c", probe, str(folder)],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.startswith(str(folder / "aarecovery_bridge")), proc.stdout
+    # Helpers from another release: the plug-in stops with a message that says what to run.
+    with pytest.raises(aarecovery_bridge.PluginError, match="aarecovery 0.0.9 but its helper modules .* "
+                       "install both again with: aarecovery gimp install"):
+        aarecovery_bridge.check_version("0.0.9", "aarecovery-gimp.py", "aarecovery gimp install")
+    (folder / "aarecovery_bridge" / "npy.py").write_text("# an older copy\n")
+    info = inst.status(tmp_path)
+    assert not info["current"] and any("differs" in p for p in info["problems"])
+
+
+def test_npy_codec_round_trips_with_numpy(tmp_path):
+    data = np.random.default_rng(2).random((5, 7, 3), dtype=np.float32)
+    npy.write_npy(tmp_path / "a.npy", data.tobytes(), data.shape)
+    np.testing.assert_array_equal(np.load(tmp_path / "a.npy"), data)
+    np.save(tmp_path / "b.npy", data)
+    assert npy.read_npy(tmp_path / "b.npy", data.nbytes) == data.tobytes()
+    with pytest.raises(aarecovery_bridge.PluginError, match="returned 420 bytes, expected 8"):
+        npy.read_npy(tmp_path / "b.npy", 8)
 
 
 def test_zip_has_executable_plugin(tmp_path):
@@ -254,10 +277,20 @@ def test_zip_has_executable_plugin(tmp_path):
         config = json.loads(zf.read("aarecovery-gimp/config.json"))
         assert config == {"python": "", "aarecovery_version": aarecovery.__version__}
         assert "aarecovery-gimp/README.txt" in zf.namelist()
+        for rel, source in inst.plugin_files():
+            assert zf.read(f"aarecovery-gimp/{rel.as_posix()}") == source.read_bytes()
+
+
+def run_worker(folder, tmp_path):
+    """The worker process exactly as the installed plug-in in `folder` starts it."""
+    return subprocess.run([sys.executable, "-c", worker.WORKER, str(folder),
+                           *(str(tmp_path / n) for n in ("o.npy", "f.npy", "r.npy", "p.json"))],
+                          capture_output=True, text=True)
 
 
 def test_worker_mode_matches_recover(tmp_path):
     """The out-of-process side, run as GIMP's plug-in would run it, needs no GIMP."""
+    inst.install(tmp_path / "plug-ins")
     rng = np.random.default_rng(5)
     original = rng.random((12, 9, 3), dtype=np.float32)
     filtered = (original > 0.5).astype(np.float32)
@@ -266,9 +299,8 @@ def test_worker_mode_matches_recover(tmp_path):
     params = {"sigma_d": 0.1, "sigma_e": 0.01, "iterations": 3, "backend": "numpy",
               "linear": False, "clip_filtered": False}
     (tmp_path / "p.json").write_text(json.dumps(params))
-    proc = subprocess.run([sys.executable, str(inst.plugin_source()), "--worker",
-                           *(str(tmp_path / n) for n in ("o.npy", "f.npy", "r.npy", "p.json"))],
-                          capture_output=True, text=True, check=True)
+    proc = run_worker(tmp_path / "plug-ins" / inst.PLUGIN_NAME, tmp_path)
+    assert proc.returncode == 0, proc.stderr
     reply = json.loads(proc.stdout.strip().splitlines()[-1])
     assert reply["backend"] == "numpy"
     expected = aarecovery.recover(original, filtered, backend="numpy")
@@ -279,9 +311,8 @@ def test_worker_mode_reports_bad_input(tmp_path):
     np.save(tmp_path / "o.npy", np.zeros((4, 4, 3), np.float32))
     np.save(tmp_path / "f.npy", np.zeros((5, 4, 3), np.float32))
     (tmp_path / "p.json").write_text(json.dumps({"backend": "numpy", "linear": False}))
-    proc = subprocess.run([sys.executable, str(inst.plugin_source()), "--worker",
-                           *(str(tmp_path / n) for n in ("o.npy", "f.npy", "r.npy", "p.json"))],
-                          capture_output=True, text=True)
+    inst.install(tmp_path / "plug-ins")
+    proc = run_worker(tmp_path / "plug-ins" / inst.PLUGIN_NAME, tmp_path)
     assert proc.returncode == 0
     assert "error" in json.loads(proc.stdout.strip().splitlines()[-1])
     assert not (tmp_path / "r.npy").exists()
@@ -296,20 +327,14 @@ def test_help(argv, capsys):
 
 
 def test_plugin_dialog_repeats_the_core_parameters_exactly():
-    """The plug-in script runs in GIMP's Python, which may not import the core, so it repeats
-    every recovery parameter; each must equal aarecovery.PARAMETERS (name, kind, range,
-    default, help)."""
-    import ast
-    tree = ast.parse(inst.plugin_source().read_text(encoding="utf-8"))
-    table = next(node.value for node in tree.body if isinstance(node, ast.Assign)
-                 and any(getattr(target, "id", None) == "RECOVERY_ARGUMENTS" for target in node.targets))
-    rows = ast.literal_eval(table)
+    """The plug-ins run in a host's Python, which may not import the core, so the bridge
+    repeats every recovery parameter; each must equal aarecovery.PARAMETERS (name, kind,
+    range, default, help)."""
+    rows = parameters.RECOVERY_ARGUMENTS
     assert [row[0] for row in rows] == [spec.name.replace("_", "-") for spec in aarecovery.PARAMETERS.values()]
     for (_, _, kind, minimum, maximum, default, blurb), spec in zip(rows, aarecovery.PARAMETERS.values()):
         assert (kind, minimum, maximum, default, blurb) == (spec.kind.__name__, spec.minimum, spec.maximum,
                                                             spec.default, spec.help)
     # A parameter the safe default chooses has an "automatic" box, with the core's words.
-    automatic = ast.literal_eval(next(node.value for node in tree.body if isinstance(node, ast.Assign) and any(
-        getattr(target, "id", None) == "AUTOMATIC_ARGUMENTS" for target in node.targets)))
-    assert {name: blurb for name, (_, _, blurb) in automatic.items()} == {
+    assert {name: blurb for name, (_, _, blurb) in parameters.AUTOMATIC_ARGUMENTS.items()} == {
         spec.name.replace("_", "-"): spec.automatic for spec in aarecovery.PARAMETERS.values() if spec.automatic}
