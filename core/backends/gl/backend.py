@@ -342,6 +342,8 @@ class GLBackend:
             sources["transfer_table"] = self._transfer_table(prior)
             uniforms.update(self._pure_colour_uniforms(prior))
         defines = {**self._defines, "PURE_COLOURS": int(prior is not None)}
+        if prior is not None:
+            defines.update(self._pure_colour_defines(prior))
         with self._passes():
             if active not in self._working_lists:
                 self._to_working_space(lists, "dilated")
@@ -372,16 +374,19 @@ class GLBackend:
         self._textures["transfer_table"].write(np.ascontiguousarray(prior.table, np.float32))
         return self._textures["transfer_table"]
 
+    @staticmethod
+    def _pure_colour_defines(prior):
+        """The prior's switches, compiled in (pure_colours.glsl says why)."""
+        return dict(TABLE_KEY=prior.key_code, CLAMP_ENDS=int(prior.key_low is not None), TO_CUBE=int(prior.to_cube))
+
     def _pure_colour_uniforms(self, prior):
-        """The palette and the table's keys as uniforms."""
+        """The palette and the table's key range as uniforms."""
         palette = np.zeros((PALETTE_SIZE, 3), np.float32)
         colours = prior.palette_in(self._blend_space)
         palette[:len(colours)] = colours
         low, high = prior.key_range()
-        return dict(table_key=prior.key_code, palette_size=len(colours),
-                    palette=[tuple(map(float, colour)) for colour in palette],
-                    key_low=tuple(map(float, low)), key_high=tuple(map(float, high)),
-                    clamp_ends=int(prior.key_low is not None), to_cube=int(prior.to_cube))
+        return dict(palette_size=len(colours), palette=[tuple(map(float, colour)) for colour in palette],
+                    key_low=tuple(map(float, low)), key_high=tuple(map(float, high)))
 
     def _fit_blend_model(self, sources, uniforms, defines, lists, maps):
         """The model and the first Jacobi iterate (and the edge map, the fixed pure colours)."""
