@@ -16,7 +16,7 @@ Passes (each has a NumPy twin of the same name in ``aarecovery.spec.passes``):
 Passes 1 and 2 cover only the blocks of 16 x 16 pixels where the edge strength can be
 non-zero (``blocks.py``): where F is not flat for the paper's model, where O is not flat with
 pure colours (whose edge strength does not need F's gradient). Pass 3 covers the other
-blocks. The block lists are made on the GPU right after the upload (``classify.py``) and
+blocks. The block lists are made on the GPU when a run first needs them (``classify.py``) and
 drive the draws and dispatches indirectly. On llvmpipe, which shades every covered
 fragment, this is what makes mostly flat results (threshold, posterize) fast; on a GPU it
 saves the work of idle lanes.
@@ -184,9 +184,9 @@ class GLBackend:
         self._classified = set()
         self._working_lists = set()
         self._ran = None
-        # F's blocks now, while its upload is fresh; O's are needed only with pure colours.
-        self._block_lists("filtered")
-        self._stage("classify")
+        # The blocks are classified when a run first needs them: F's for the paper's model,
+        # O's alone with pure colours (classifying F as well cost 25 x 10-17 ms of CPU in the
+        # 1024 tiles of a 4096 x 4096 thin-feature pair on llvmpipe).
 
     def _configure(self, o_layout, f_layout, linear_input, blend_space):
         """The shader defines and formats for a pair; returns the textures' dtypes for O and F."""
