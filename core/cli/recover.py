@@ -93,27 +93,41 @@ def add_parameter_options(parser):
                             help=f"{spec.help} ({spec.minimum:g} to {spec.maximum:g}; {default})")
 
 
-def _read_pair(args):
-    """Decode both images in two threads: the codecs release the GIL."""
-    from concurrent.futures import ThreadPoolExecutor
+def _reads_whole(args):
+    """Whether the pair is read whole: anything but a TIFF that can be read in pieces, which
+    may stream tile by tile once the engine has said its tile size."""
+    from ..io.tiled import tiff_regions
 
-    from .inputs import check_pair_size, read_input
+    if args.maps is not None:
+        return True
+    regions = tiff_regions(args.original)
+    if regions is None:
+        return True
+    regions.close()
+    return False
 
-    paths = (args.original, args.filtered)
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        original, filtered = pool.map(lambda path: read_input(path, args), paths)
-    check_pair_size(original, filtered, paths)
+
+def _start_reading(pool, args):
+    """Decode both images in two threads of `pool`: the codecs release the GIL."""
+    from .inputs import read_input
+
+    return [pool.submit(read_input, path, args) for path in (args.original, args.filtered)]
+
+
+def _finish_reading(reads, args):
+    from .inputs import check_pair_size
+
+    original, filtered = (read.result() for read in reads)
+    check_pair_size(original, filtered, (args.original, args.filtered))
     return original, filtered
 
 
 def run(args):
     """Run ``aarecovery recover`` with parsed arguments; return the exit status."""
-    import time
+    from concurrent.futures import ThreadPoolExecutor
 
-    from ..engine import Engine
-    from ..io import check_output_path, write_images
+    from ..io import check_output_path
     from ..params import Parameters
-    from ..pipeline import recover
     from ..tiling import check_tile_size
     from .outputs import check_destinations, remove_stale_parts_of
 
@@ -131,16 +145,33 @@ def run(args):
     check_destinations(outputs, inputs, overwrite=args.overwrite, folders=[args.maps] if args.maps else [])
     remove_stale_parts_of(outputs)
 
-    # Before reading: a backend that cannot run (no OpenGL) says so at once.
+    pool = ThreadPoolExecutor(max_workers=2)
+    try:
+        return _recover_files(args, params, pool)
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
+
+
+def _recover_files(args, params, pool):
+    """The pair read, recovered and written, with `pool`'s two threads for the files."""
+    import time
+
+    from ..engine import Engine
+    from ..io import check_output_path, write_images
+    from ..pipeline import recover
+
+    # A pair read whole decodes while the engine makes its GL context; when it cannot (no
+    # OpenGL), the error comes without waiting for the decoding.
+    reads = _start_reading(pool, args) if _reads_whole(args) else None
     engine = Engine(args.backend, gl_path=args.gl_path)
     try:
-        pair = None if args.maps is not None else _open_streamed(args, params, engine)
+        pair = None if reads is not None else _open_streamed(args, params, engine)
         if pair is not None:
             with pair:
                 for line in _recover_streamed(args, params, pair, engine):
                     print(line)
             return 0
-        original, filtered = _read_pair(args)
+        original, filtered = _finish_reading(reads or _start_reading(pool, args), args)
         # Before the recovery, so that a long run does not end in a refusal.
         check_output_path(args.output, filtered.shape)
         start = time.perf_counter()
@@ -160,6 +191,8 @@ def run(args):
     if maps is not None:
         os.makedirs(args.maps, exist_ok=True)
         images.update(maps_as_images(args.maps, maps))
+    # The summary counts the changed pixels while the encoder writes (both release the GIL).
+    summary = pool.submit(summary_line, plan, original, filtered, result)
     # All or none: a failure while writing any map leaves the result unwritten too.
     write_images(images)
     message = (f"wrote {args.output} ({result.shape[1]}x{result.shape[0]}, {result.dtype}) "
@@ -167,7 +200,7 @@ def run(args):
     if args.maps is not None:
         message += f"; maps in {args.maps}"
     print(message)
-    print(summary_line(plan, original, filtered, result))
+    print(summary.result())
     return 0
 
 
