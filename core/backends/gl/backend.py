@@ -61,7 +61,7 @@ _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("mode
                  "edge_strength": ("edge", 0)}
 # The textures made when first needed: (components, dtype); "result" has F's.
 _WORK_TEXTURES = {"original_work": (4, "f4"), "filtered_work": (4, "f4"), "model": (4, "f4"), "edge": (1, "f4"),
-                  "fixed_a": (4, "f4"), "fixed_b": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4")}
+                  "jacobi_constant": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4")}
 _RESULT_BITS = {np.dtype(np.uint8): 8, np.dtype(np.uint16): 16}
 
 #: How a texture of 1 to 4 channels reads as straight RGBA: the texture unit expands grey
@@ -389,7 +389,7 @@ class GLBackend:
                     key_low=tuple(map(float, low)), key_high=tuple(map(float, high)))
 
     def _fit_blend_model(self, sources, uniforms, defines, lists, maps):
-        """The model and the first Jacobi iterate (and the edge map, the fixed pure colours)."""
+        """The model and the first Jacobi iterate (and the edge map, the Jacobi steps' constant with pure colours)."""
         pure = defines["PURE_COLOURS"]
         outputs = [self._work("model"), self._work("iterate_a")]
         if maps:
@@ -399,8 +399,8 @@ class GLBackend:
             self._framebuffer([outputs[2]]).clear(0.0, 0.0, 0.0, 0.0)
         locations = {}
         if pure:
-            outputs += [self._work("fixed_a"), self._work("fixed_b")]
-            locations = dict(FIXED_LOCATION=2 + int(maps), FIXED_LOCATION_B=3 + int(maps))
+            outputs.append(self._work("jacobi_constant"))
+            locations = dict(CONSTANT_LOCATION=2 + int(maps))
         self._path.run_pass("fit_blend_model", sources, outputs, blocks=lists, list_name="active", uniforms=uniforms,
                             defines={**defines, "MAPS": int(maps), "SHARED_TILE": int(self.shared_tile), **locations})
 
@@ -413,7 +413,7 @@ class GLBackend:
         """
         inputs = {**sources, "model_map": self._work("model")}
         if defines["PURE_COLOURS"]:
-            inputs.update(fixed_a_map=self._work("fixed_a"), fixed_b_map=self._work("fixed_b"))
+            inputs["jacobi_constant_map"] = self._work("jacobi_constant")
         previous = self._work("iterate_a") if iterations > 1 else sources["filtered_work"]
         for step in range(2 if iterations > 1 else 1, iterations + 1):
             final = step == iterations
