@@ -15,7 +15,7 @@ from .plan.calibration import EDGE_GRADIENT
 from .sample import analysis_window
 from .spec.sobel import gradient_magnitude
 
-__all__ = ["RecoverySummary", "summarize_recovery"]
+__all__ = ["RecoverySummary", "summarize_recovery", "count_changed_pixels"]
 
 # A pixel counts as repaired when R differs from F there by more than half an 8-bit step.
 _CHANGED = 0.5 / 255
@@ -79,7 +79,15 @@ def _changed(filtered, recovered):
     return changed
 
 
-def summarize_recovery(plan, original, filtered, recovered):
+def count_changed_pixels(filtered, recovered):
+    """Pixels where `recovered` differs from `filtered` by more than half an 8-bit step, in
+    strips of rows (a few MB of memory whatever the size: it can run beside the encoder)."""
+    height = layout_of(filtered, "filtered").height
+    return sum(int(_changed(filtered[top:top + _STRIP_ROWS], recovered[top:top + _STRIP_ROWS]).sum())
+               for top in range(0, height, _STRIP_ROWS))
+
+
+def summarize_recovery(plan, original, filtered, recovered, *, changed_pixels=None):
     """Summarize a recovery of `original` and `filtered` into `recovered` under `plan`.
 
     Parameters
@@ -90,17 +98,19 @@ def summarize_recovery(plan, original, filtered, recovered):
     original, filtered, recovered : ndarray
         As given to and returned by :func:`aarecovery.recover`; `recovered` has the shape
         and dtype of `filtered`.
+    changed_pixels : int, optional
+        :func:`count_changed_pixels` of the pair when already counted.
 
     Returns
     -------
     RecoverySummary
     """
     f_layout = layout_of(filtered, "filtered")
-    changed = sum(int(_changed(filtered[top:top + _STRIP_ROWS], recovered[top:top + _STRIP_ROWS]).sum())
-                  for top in range(0, f_layout.height, _STRIP_ROWS))
+    if changed_pixels is None:
+        changed_pixels = count_changed_pixels(filtered, recovered)
     window = analysis_window(lambda rows, cols: original[rows, cols], f_layout.height, f_layout.width)
     o_window = original[window]
     edges = gradient_magnitude(to_rgba_float(o_window, layout_of(o_window, "original"), "original")[..., :3])
     edges = edges >= EDGE_GRADIENT
     share = float(_changed(filtered[window], recovered[window])[edges].mean()) if edges.any() else 0.0
-    return RecoverySummary(plan, changed, share)
+    return RecoverySummary(plan, changed_pixels, share)

@@ -158,6 +158,7 @@ def _recover_files(args, params, pool):
 
     from ..engine import Engine
     from ..io import check_output_path, write_images
+    from ..outcome import count_changed_pixels
     from ..pipeline import recover
 
     # A pair read whole decodes while the engine makes its GL context; when it cannot (no
@@ -191,8 +192,9 @@ def _recover_files(args, params, pool):
     if maps is not None:
         os.makedirs(args.maps, exist_ok=True)
         images.update(maps_as_images(args.maps, maps))
-    # The summary counts the changed pixels while the encoder writes (both release the GIL).
-    summary = pool.submit(summary_line, plan, original, filtered, result)
+    # The changed pixels are counted while the encoder writes (both release the GIL; the
+    # count needs a few MB, the rest of the summary 20 MB at 4096 x 4096, so it comes after).
+    counting = pool.submit(count_changed_pixels, filtered, result)
     # All or none: a failure while writing any map leaves the result unwritten too.
     write_images(images)
     message = (f"wrote {args.output} ({result.shape[1]}x{result.shape[0]}, {result.dtype}) "
@@ -200,16 +202,16 @@ def _recover_files(args, params, pool):
     if args.maps is not None:
         message += f"; maps in {args.maps}"
     print(message)
-    print(summary.result())
+    print(summary_line(plan, original, filtered, result, changed_pixels=counting.result()))
     return 0
 
 
-def summary_line(plan, original=None, filtered=None, recovered=None):
+def summary_line(plan, original=None, filtered=None, recovered=None, changed_pixels=None):
     """What the recovery did, in the command line's words (the plan alone for a streamed pair)."""
     from ..outcome import RecoverySummary, summarize_recovery
 
     summary = (RecoverySummary(plan, None, None) if recovered is None
-               else summarize_recovery(plan, original, filtered, recovered))
+               else summarize_recovery(plan, original, filtered, recovered, changed_pixels=changed_pixels))
     return summary.line(force="--strength 1")
 
 
