@@ -44,7 +44,9 @@ def test_bench_process_times_whole_processes_and_prints_their_ratios(capsys):
         assert all(row["peak_bytes"] > 10 * 2**20 and row["seconds"] > 0 for row in pair["rows"].values())
         assert set(pair["ratios"]) == {"safe/paper", "numpy-paper/safe"} | ({"safe/gegl"} if gegl else set())
         assert all(ratio > 0 for ratio in pair["ratios"].values())
-    assert captured.err.count("ratios: safe/paper") == 2
+        assert set(pair["cpu_ratios"]) == set(pair["ratios"]) and all(row["cpu_seconds"] > 0
+                                                                       for row in pair["rows"].values())
+    assert captured.err.count("  ratios: safe/paper") == 2 and captured.err.count("CPU-time ratios: safe/paper") == 2
     assert gegl or "gegl:antialias skipped" in captured.err
 
 

@@ -12,7 +12,9 @@ own, as a user runs it, timed with its peak resident memory:
 
 The machines are shared, so the commands run in turn (safe, paper, gegl, numpy-paper, then
 again) and each figure is the median of its runs: the ratios then hold while the load
-drifts. The NumPy program is slow and runs once per pair unless more runs are asked for.
+drifts. The CPU seconds of each process (all its threads) are reported beside the wall
+seconds: on a loaded machine they move less. The NumPy program is slow and runs once per
+pair unless more runs are asked for.
 """
 
 import os
@@ -115,24 +117,26 @@ def _time_pair(name, width, height, runs, numpy_runs, folder, log):
         for command, line in lines.items():
             if command == "numpy-paper" and run >= numpy_runs:
                 continue
-            peak, seconds = measure_command(line)
-            measured[command].append((seconds, peak))
+            measured[command].append(measure_command(line, cpu=True))
     rows = {}
     for command, results in measured.items():
-        seconds = [result[0] for result in results]
+        seconds = [result[1] for result in results]
         rows[command] = {"seconds": statistics.median(seconds), "runs": seconds,
-                         "peak_bytes": max(result[1] for result in results),
+                         "cpu_seconds": statistics.median(result[2] for result in results),
+                         "peak_bytes": max(result[0] for result in results),
                          "mps": width * height / statistics.median(seconds) / 1e6}
-    ratios = {label: rows[top]["seconds"] / rows[bottom]["seconds"]
-              for label, top, bottom in RATIOS if top in rows and bottom in rows}
+    ratios, cpu_ratios = ({label: rows[top][key] / rows[bottom][key]
+                           for label, top, bottom in RATIOS if top in rows and bottom in rows}
+                          for key in ("seconds", "cpu_seconds"))
     report = {"pair": name, "what": what, "size": f"{width}x{height}", "rows": rows, "ratios": ratios,
-              "load": [load_before, _load()]}
+              "cpu_ratios": cpu_ratios, "load": [load_before, _load()]}
     log(f"{name} {width}x{height}: {what} (load {load_before} -> {report['load'][1]})")
     for command, row in rows.items():
         spread = ", ".join(f"{s:.2f}" for s in row["runs"])
-        log(f"  {command:12s} {row['seconds']:7.2f} s  {row['mps']:7.2f} MP/s  peak {row['peak_bytes'] / 2**30:.2f} GiB"
-            f"  (runs: {spread})")
+        log(f"  {command:12s} {row['seconds']:7.2f} s  {row['mps']:7.2f} MP/s  CPU {row['cpu_seconds']:6.2f} s  "
+            f"peak {row['peak_bytes'] / 2**30:.2f} GiB  (runs: {spread})")
     log("  ratios: " + ", ".join(f"{label} {value:.2f}x" for label, value in ratios.items()))
+    log("  CPU-time ratios: " + ", ".join(f"{label} {value:.2f}x" for label, value in cpu_ratios.items()))
     return report
 
 
@@ -154,8 +158,9 @@ def bench_processes(width, height, runs, *, numpy_runs=1, pairs=tuple(PAIRS), lo
     Returns
     -------
     dict
-        ``pairs``: per pair its rows (median seconds, each run's seconds, megapixels per
-        second and peak bytes per command) and its ratios; ``skipped``: commands not run and why.
+        ``pairs``: per pair its rows (median wall seconds, each run's, megapixels per second,
+        median CPU seconds and peak bytes per command), its ratios of wall seconds and of CPU
+        seconds and the load average before and after; ``skipped``: commands not run and why.
     """
     report = {"pairs": [], "skipped": {}}
     if which("gegl") is None:
