@@ -1,7 +1,9 @@
 """``aarecovery bench`` runs every stage and configuration and writes its report as JSON."""
 
 import json
+import shutil
 
+import numpy as np
 import pytest
 
 from aarecovery.cli import main
@@ -10,10 +12,10 @@ from aarecovery.lab.bench import STAGES
 pytestmark = pytest.mark.gl
 
 
-def test_bench_reports_stages_configurations_and_processes(tmp_path, capsys):
+def test_bench_reports_stages_and_configurations(tmp_path, capsys):
     report_path = tmp_path / "bench.json"
     status = main(["bench", "--sizes", "64x48", "--runs", "1", "--filters", "threshold",
-                   "--configs", "gl-fragment,gl-compute,numpy", "--process", "40x32", "--json", str(report_path)])
+                   "--configs", "gl-fragment,gl-compute,numpy", "--json", str(report_path)])
     assert status == 0
     printed = capsys.readouterr().out
     assert "gl-compute" in printed and "MP/s" in printed
@@ -25,10 +27,46 @@ def test_bench_reports_stages_configurations_and_processes(tmp_path, capsys):
         assert seconds > 0, stage
     for figures in row["configs"].values():
         assert figures["paper_mps"] > 0 and figures["safe_mps"] > 0 and figures["passes_mps"] > 0
-    rows = report["process"]["rows"]
-    assert set(rows) == {"gl-fragment safe", "gl-fragment paper", "gl-compute safe", "gl-compute paper", "numpy safe"}
-    assert all(row["peak_bytes"] > 10 * 2**20 and row["seconds"] > 0 for row in rows.values())
-    assert rows["gl-fragment safe"]["ratio_to_numpy"] > 0
+
+
+def test_bench_process_times_whole_processes_and_prints_their_ratios(capsys):
+    # Both kinds of pair, small: every command runs file to file; gegl only where installed.
+    status = main(["bench", "--process", "96", "--runs", "1", "--json"])
+    assert status == 0
+    captured = capsys.readouterr()
+    report = json.loads(captured.out)  # stdout is the JSON report alone
+    gegl = shutil.which("gegl") is not None
+    pairs = report["process"]["pairs"]
+    assert [pair["pair"] for pair in pairs] == ["thin", "photo"]
+    for pair in pairs:
+        assert pair["size"] == "96x96"
+        assert set(pair["rows"]) == {"safe", "paper", "numpy-paper"} | ({"gegl"} if gegl else set())
+        assert all(row["peak_bytes"] > 10 * 2**20 and row["seconds"] > 0 for row in pair["rows"].values())
+        assert set(pair["ratios"]) == {"safe/paper", "numpy-paper/safe"} | ({"safe/gegl"} if gegl else set())
+        assert all(ratio > 0 for ratio in pair["ratios"].values())
+        assert set(pair["cpu_ratios"]) == set(pair["ratios"]) and all(row["cpu_seconds"] > 0
+                                                                       for row in pair["rows"].values())
+    assert captured.err.count("  ratios: safe/paper") == 2 and captured.err.count("CPU-time ratios: safe/paper") == 2
+    assert gegl or "gegl:antialias skipped" in captured.err
+
+
+def test_the_thin_features_pair_makes_the_safe_default_pick_pure_colours():
+    from aarecovery.lab.processes import thin_features_pair
+    from aarecovery.params import Parameters
+    from aarecovery.plan import make_plan
+    original, filtered = thin_features_pair(256, 256)
+    assert make_plan(original, filtered, Parameters()).pure_colours is not None
+
+
+def test_the_numpy_yardstick_is_the_papers_method():
+    # Written independently of the specification, it gives the paper mode's result.
+    import aarecovery
+    from aarecovery.lab.bench import bench_image_pair
+    from aarecovery.lab.paper_numpy import recover_paper
+    original, filtered = bench_image_pair(64, 48)
+    expected = aarecovery.recover(original, filtered, backend="numpy", mode="paper")
+    assert (expected != filtered).any()
+    assert np.abs(recover_paper(original, filtered).astype(np.int64) - expected).max() <= 1
 
 
 def test_bench_refuses_an_unknown_configuration(capsys):

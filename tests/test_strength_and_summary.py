@@ -96,6 +96,22 @@ def test_summary_of_a_float_grey_pair_counts_in_its_own_scale():
     assert summary.changed_pixels == (np.abs(recovered - filtered) > 0.5 / 255).sum() > 0
 
 
+@pytest.mark.parametrize("channels", [1, 4])
+def test_summary_counts_16_bit_changes_above_half_an_8_bit_step(channels):
+    # Half an 8-bit step is 128.5 of 65535: a change of 128 does not count, 129 does, in any
+    # channel, counted in the images' own integers.
+    filtered = np.full((6, 5, channels), 30000, np.uint16)
+    recovered = filtered.copy()
+    recovered[0, 0, -1] += 128
+    recovered[1, 1, 0] -= 129
+    recovered[2, 2, -1] += 129
+    recovered[3, 3, 0] = 0
+    if channels == 1:
+        filtered, recovered = filtered[..., 0], recovered[..., 0]
+    summary = aarecovery.summarize_recovery(aarecovery.Plan(sigma_d=0.1, sigma_e=0.01, iterations=3), filtered, filtered, recovered)
+    assert summary.changed_pixels == 3
+
+
 def test_recover_prints_the_summary_and_takes_strength(tmp_path, capsys, blur_pair):
     original, filtered = blur_pair
     aarecovery.write_image(tmp_path / "o.png", original)

@@ -2,6 +2,7 @@
 
 import argparse
 import json
+import sys
 
 from ..errors import InputError
 from ..lab.bench import CONFIGS, DEFAULT_CONFIGS, DEFAULT_SIZES
@@ -11,9 +12,10 @@ __all__ = ["register", "run"]
 
 def _size(text):
     try:
-        width, height = (int(v) for v in text.lower().split("x"))
+        parts = [int(v) for v in text.lower().split("x")]
+        width, height = parts * 2 if len(parts) == 1 else parts
     except ValueError:
-        raise InputError(f"a size is WIDTHxHEIGHT, such as 1920x1080; got {text!r}") from None
+        raise InputError(f"a size is WIDTHxHEIGHT, such as 1920x1080, or one side of a square; got {text!r}") from None
     if width < 1 or height < 1:
         raise InputError(f"a size needs at least one pixel each way, got {text!r}")
     return width, height
@@ -27,20 +29,52 @@ def _configs(text):
     return configs
 
 
+def _write_json(report, where):
+    if where == "-":
+        print(json.dumps(report, indent=2))
+        return
+    with open(where, "w") as out:
+        json.dump(report, out, indent=2)
+
+
+def _log_to(args):
+    """Where the human-readable lines go: stderr when the JSON report takes stdout."""
+    stream = sys.stderr if args.json == "-" else sys.stdout
+    return lambda line: print(line, file=stream, flush=True)
+
+
 def run(args):
     """Run ``aarecovery bench`` with parsed arguments; return the exit status."""
-    if args.batch is not None or args.gigapixel:
-        return _run_scale(args)
-    from ..lab.bench import run_bench
-
     if args.runs < 1:
         raise InputError(f"--runs must be at least 1, got {args.runs}")
+    if args.batch is not None or args.gigapixel:
+        return _run_scale(args)
+    if args.process:
+        return _run_processes(args)
+    from ..lab.bench import run_bench
+
     report = run_bench([_size(size) for size in args.sizes.split(",")], _configs(args.configs),
-                       args.filters.split(","), args.runs, process=_size(args.process) if args.process else None,
-                       log=lambda line: print(line, flush=True))
+                       args.filters.split(","), args.runs, log=_log_to(args))
     if args.json:
-        with open(args.json, "w") as out:
-            json.dump(report, out, indent=2)
+        _write_json(report, args.json)
+    return 0
+
+
+def _run_processes(args):
+    from ..lab.bench import machine
+    from ..lab.processes import PAIRS, bench_processes
+
+    width, height = _size(args.process)
+    pairs = args.pairs.split(",")
+    unknown = [pair for pair in pairs if pair not in PAIRS]
+    if unknown:
+        raise InputError(f"unknown pair {unknown[0]!r}; choose from {', '.join(PAIRS)}")
+    log = _log_to(args)
+    report = {"machine": machine()}
+    log(f"machine: {report['machine']}")
+    report["process"] = bench_processes(width, height, args.runs, numpy_runs=args.numpy_runs, pairs=pairs, log=log)
+    if args.json:
+        _write_json(report, args.json)
     return 0
 
 
@@ -50,11 +84,10 @@ def register(subparsers):
         description="Times the stages of a file-to-file recovery (decode, plan, upload, classify, passes, "
                     "readback, encode) on a generated photo-like 8-bit RGB pair, and the end-to-end throughput "
                     "of each engine configuration in megapixels per second (the paper's method and the safe "
-                    "default), medians of several runs after a warm-up; ratios come from one run. --process "
-                    "also times whole 'aarecovery recover' processes file to file, with their peak memory; "
-                    "--batch and --gigapixel measure batches and streamed pairs instead.",
+                    "default), medians of several runs after a warm-up; ratios come from one run. --process, "
+                    "--batch and --gigapixel measure whole processes, batches and streamed pairs instead.",
         epilog="examples:\n  aarecovery bench\n  aarecovery bench --sizes 3840x2160 --filters gamma --configs gl-compute\n"
-               "  aarecovery bench --process --json bench.json\n"
+               "  aarecovery bench --process --json bench.json\n  aarecovery bench --process 256 --runs 1 --json\n"
                "  aarecovery bench --batch 100\n  aarecovery bench --gigapixel 50000x50000 --folder /scratch",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes", default=",".join(f"{w}x{h}" for w, h in DEFAULT_SIZES),
@@ -68,8 +101,16 @@ def register(subparsers):
     parser.add_argument("--runs", type=int, default=5, help="timed runs per figure; NumPy gets a third "
                         "(default %(default)s)")
     parser.add_argument("--process", metavar="WxH", nargs="?", const="4096x4096",
-                        help="also time whole 'aarecovery recover' processes on a thresholded pair of PNG files "
-                             "of this size, with peak memory (default when given without a value: 4096x4096)")
+                        help="instead: whole processes file to file on PNG pairs of this size (WxH, or one side of "
+                             "a square), run in turn: 'aarecovery recover' (safe default), '--paper', GIMP's "
+                             "gegl:antialias on F (when the gegl command is installed) and the paper's method as "
+                             "straightforward NumPy; medians, peak memory and their ratios (default when given "
+                             "without a value: 4096x4096)")
+    parser.add_argument("--pairs", default="thin,photo",
+                        help="with --process: thin (thin features, pure colours) and/or photo (photo-like), "
+                             "default %(default)s")
+    parser.add_argument("--numpy-runs", type=int, default=1,
+                        help="with --process: runs of the NumPy program, at most --runs (default %(default)s)")
     parser.add_argument("--batch", metavar="N", type=int, nargs="?", const=100,
                         help="instead: N pairs of 1920x1080 PNGs through one 'aarecovery batch' (with 1 to 4 "
                              "workers) against N separate 'aarecovery recover' calls, in images per second "
@@ -80,7 +121,9 @@ def register(subparsers):
     parser.add_argument("--folder", metavar="DIR",
                         help="where --batch and --gigapixel write their files (default: a temporary folder; a "
                              "50000x50000 pair takes about 6 GB)")
-    parser.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
+    parser.add_argument("--json", metavar="FILE", nargs="?", const="-",
+                        help="also write the figures as JSON to FILE, or to stdout when no FILE is given (the "
+                             "readable lines then go to stderr)")
     parser.set_defaults(run=run)
     return parser
 
@@ -94,13 +137,12 @@ def _run_scale(args):
         raise InputError(f"--batch needs at least 1 pair, got {args.batch}")
     report = {}
     with tempfile.TemporaryDirectory(dir=args.folder, prefix="aarecovery-bench-") as folder:
-        log = lambda line: print(line, flush=True)  # noqa: E731
+        log = _log_to(args)
         if args.batch is not None:
             report["batch"] = bench_batch(folder, args.batch, log=log)
         if args.gigapixel:
             width, height = _size(args.gigapixel)
             report["gigapixel"] = bench_gigapixel(folder, width, height, log=log)
     if args.json:
-        with open(args.json, "w") as out:
-            json.dump(report, out, indent=2)
+        _write_json(report, args.json)
     return 0

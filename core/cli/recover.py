@@ -97,32 +97,53 @@ def add_parameter_options(parser):
                             help=f"{spec.help} ({spec.minimum:g} to {spec.maximum:g}; {default})")
 
 
-def _read_pair(args, engine):
-    """Decode both images in two threads (the codecs release the GIL), once the recovery's
-    peak is known to fit the image memory limit."""
-    from concurrent.futures import ThreadPoolExecutor
+def _reads_whole(args):
+    """Whether the pair is read whole: anything but a TIFF that can be read in pieces, which
+    may stream tile by tile once the engine has said its tile size."""
+    from ..io.tiled import tiff_regions
 
+    if args.maps is not None:
+        return True
+    regions = tiff_regions(args.original)
+    if regions is None:
+        return True
+    regions.close()
+    return False
+
+
+def _largest_tile(args):
+    """The largest tile side the chosen backend may use, known before its engine is made."""
+    from ..tiling import DEFAULT_TILES
+
+    return args.tile_size or DEFAULT_TILES["numpy" if args.backend == "numpy" else "gl"]
+
+
+def _start_reading(pool, args):
+    """Decode both images in two threads of `pool` (the codecs release the GIL), once the
+    recovery's peak is known to fit the image memory limit: with the largest tile the
+    backend may use, as the engine that says its tile is made while the images decode."""
     from ..memory import check_pair_files
-    from ..pipeline import tile_side
-    from .inputs import check_pair_size, memory_limit, read_input
+    from .inputs import memory_limit, read_input
 
     paths = (args.original, args.filtered)
-    check_pair_files(*paths, tile_side(engine.capabilities, args.tile_size), maps=args.maps is not None,
-                     max_bytes=memory_limit(args))
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        original, filtered = pool.map(lambda path: read_input(path, args), paths)
-    check_pair_size(original, filtered, paths)
+    check_pair_files(*paths, _largest_tile(args), maps=args.maps is not None, max_bytes=memory_limit(args))
+    return [pool.submit(read_input, path, args) for path in paths]
+
+
+def _finish_reading(reads, args):
+    from .inputs import check_pair_size
+
+    original, filtered = (read.result() for read in reads)
+    check_pair_size(original, filtered, (args.original, args.filtered))
     return original, filtered
 
 
 def run(args):
     """Run ``aarecovery recover`` with parsed arguments; return the exit status."""
-    import time
+    from concurrent.futures import ThreadPoolExecutor
 
-    from ..engine import Engine
-    from ..io import check_output_path, write_images
+    from ..io import check_output_path
     from ..params import Parameters
-    from ..pipeline import recover
     from ..tiling import check_tile_size
     from .outputs import check_destinations, remove_stale_parts_of
 
@@ -140,16 +161,34 @@ def run(args):
     check_destinations(outputs, inputs, overwrite=args.overwrite, folders=[args.maps] if args.maps else [])
     remove_stale_parts_of(outputs)
 
-    # Before reading: a backend that cannot run (no OpenGL) says so at once.
+    pool = ThreadPoolExecutor(max_workers=2)
+    try:
+        return _recover_files(args, params, pool)
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
+
+
+def _recover_files(args, params, pool):
+    """The pair read, recovered and written, with `pool`'s two threads for the files."""
+    import time
+
+    from ..engine import Engine
+    from ..io import check_output_path, write_images
+    from ..outcome import count_changed_pixels
+    from ..pipeline import recover
+
+    # A pair read whole decodes while the engine makes its GL context; when it cannot (no
+    # OpenGL), the error comes without waiting for the decoding.
+    reads = _start_reading(pool, args) if _reads_whole(args) else None
     engine = Engine(args.backend, gl_path=args.gl_path)
     try:
-        pair = None if args.maps is not None else _open_streamed(args, params, engine)
+        pair = None if reads is not None else _open_streamed(args, params, engine)
         if pair is not None:
             with pair:
                 for line in _recover_streamed(args, params, pair, engine):
                     print(printable(line))
             return 0
-        original, filtered = _read_pair(args, engine)
+        original, filtered = _finish_reading(reads or _start_reading(pool, args), args)
         # Before the recovery, so that a long run does not end in a refusal.
         check_output_path(args.output, filtered.shape)
         start = time.perf_counter()
@@ -169,6 +208,9 @@ def run(args):
     if maps is not None:
         os.makedirs(args.maps, exist_ok=True)
         images.update(maps_as_images(args.maps, maps))
+    # The changed pixels are counted while the encoder writes (both release the GIL; the
+    # count needs a few MB, the rest of the summary 20 MB at 4096 x 4096, so it comes after).
+    counting = pool.submit(count_changed_pixels, filtered, result)
     # All or none: a failure while writing any map leaves the result unwritten too.
     write_images(images)
     message = (f"wrote {args.output} ({result.shape[1]}x{result.shape[0]}, {result.dtype}) "
@@ -176,16 +218,16 @@ def run(args):
     if args.maps is not None:
         message += f"; maps in {args.maps}"
     print(printable(message))
-    print(summary_line(plan, original, filtered, result, linear=args.linear))
+    print(summary_line(plan, original, filtered, result, linear=args.linear, changed_pixels=counting.result()))
     return 0
 
 
-def summary_line(plan, original=None, filtered=None, recovered=None, linear=False):
+def summary_line(plan, original=None, filtered=None, recovered=None, linear=False, changed_pixels=None):
     """What the recovery did, in the command line's words (the plan alone for a streamed pair)."""
     from ..outcome import RecoverySummary, summarize_recovery
 
     summary = (RecoverySummary(plan, None, None) if recovered is None
-               else summarize_recovery(plan, original, filtered, recovered, linear))
+               else summarize_recovery(plan, original, filtered, recovered, linear, changed_pixels=changed_pixels))
     return summary.line(force="--strength 1")
 
 

@@ -1,4 +1,4 @@
-"""What ``aarecovery bench`` measures: each stage of a recovery, throughput per GL path and NumPy, whole processes.
+"""What ``aarecovery bench`` measures: each stage of a recovery, throughput per GL path and NumPy.
 
 For each generated pair (:func:`bench_image_pair`) it times the stages a file-to-file run goes
 through: decode (both PNG files, in parallel as ``aarecovery recover`` does), plan (the safe
@@ -6,8 +6,8 @@ default's analysis; the paper's method needs none), upload, classify (the active
 the GPU), passes, readback (into F's layout), encode (the PNG file). Each engine
 configuration (:data:`CONFIGS`) also gets an end-to-end figure, as a caller waits for it:
 ``set_images``, the passes and ``result``, uninstrumented, for the paper's method and the
-safe default (the plan made beforehand). With ``process``, whole ``aarecovery recover``
-processes are timed file to file, with their peak memory.
+safe default (the plan made beforehand). Whole processes file to file are
+:mod:`aarecovery.lab.processes`.
 
 Each figure is the median of several runs after a warm-up run; ratios come from one run of
 the command, because the machines are shared and two runs of the same code differ by 15-20%.
@@ -16,8 +16,6 @@ the command, because the machines are shared and two runs of the same code diffe
 import os
 import platform
 import statistics
-import subprocess
-import sys
 import tempfile
 import time
 from collections import defaultdict
@@ -28,7 +26,7 @@ import numpy as np
 from ..colour import luma
 from ..errors import InputError
 
-__all__ = ["DEFAULT_SIZES", "CONFIGS", "STAGES", "bench_image_pair", "run_bench"]
+__all__ = ["DEFAULT_SIZES", "CONFIGS", "STAGES", "bench_image_pair", "machine", "run_bench"]
 
 DEFAULT_SIZES = ((1920, 1080), (4096, 4096))
 #: Engine configurations: the GL backend on each path (and the compute path with its fit's
@@ -174,61 +172,7 @@ def _file_stages(original, filtered, runs):
     return decode_seconds, encode
 
 
-# Runs a command and prints its seconds and the peak resident memory of its process tree.
-# It runs in a small Python of its own: a child forked from this (large) process would count
-# this process's pages in its own peak until it executes the command.
-_MEASURE = """
-import resource, subprocess, sys, time
-start = time.perf_counter()
-subprocess.run(sys.argv[1:], check=True, stdout=subprocess.DEVNULL)
-seconds = time.perf_counter() - start
-peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-print(seconds, peak if sys.platform == "darwin" else peak * 1024)
-"""
-
-#: What ``aarecovery recover`` is given for each configuration in whole-process runs.
-_PROCESS_OPTIONS = {"gl-fragment": ["--backend", "gl", "--gl-path", "fragment"],
-                    "gl-compute": ["--backend", "gl", "--gl-path", "compute"],
-                    "numpy": ["--backend", "numpy"]}
-
-
-def _processes(width, height, configs, runs, log):
-    """Whole ``aarecovery recover`` processes, file to file, on a thresholded RGB pair of PNGs."""
-    from ..io import write_image
-    original, filtered = bench_image_pair(width, height)
-    rows = {}
-    with tempfile.TemporaryDirectory() as folder:
-        paths = [os.path.join(folder, name) for name in ("o.png", "f.png", "r.png")]
-        write_image(paths[0], original)
-        write_image(paths[1], filtered)
-        del original, filtered
-        runs_of = [(config, mode) for config in configs if config in _PROCESS_OPTIONS
-                   for mode in (("safe", "paper") if config != "numpy" else ("safe",))]
-        for config, mode in runs_of:
-            command = [sys.executable, "-m", "aarecovery", "recover", *paths[:2], "-o", paths[2],
-                       *_PROCESS_OPTIONS[config]] + (["--paper"] if mode == "paper" else [])
-            measured = []
-            for _ in range(runs if config != "numpy" else max(1, runs // 3)):
-                output = subprocess.run([sys.executable, "-c", _MEASURE, *command], check=True, capture_output=True,
-                                        text=True)
-                seconds, peak = output.stdout.split()
-                measured.append((float(seconds), int(peak)))
-            seconds = statistics.median(m[0] for m in measured)
-            peak = max(m[1] for m in measured)
-            rows[f"{config} {mode}"] = {"seconds": seconds, "mps": width * height / seconds / 1e6,
-                                        "peak_bytes": peak, "runs": len(measured)}
-            log(f"  {config:12s} {mode:5s}  {seconds:6.2f} s  {width * height / seconds / 1e6:6.2f} MP/s  "
-                f"peak {peak / 2**30:.2f} GiB  ({len(measured)} runs)")
-    numpy_seconds = rows.get("numpy safe", {}).get("seconds")
-    if numpy_seconds:
-        for key, row in rows.items():
-            if key != "numpy safe":
-                row["ratio_to_numpy"] = numpy_seconds / row["seconds"]
-                log(f"  {key} / numpy safe: {row['ratio_to_numpy']:.1f}x")
-    return {"size": f"{width}x{height}", "filter": "threshold", "rows": rows}
-
-
-def _machine():
+def machine():
     cores = os.cpu_count()
     try:
         with open("/proc/cpuinfo") as info:
@@ -245,7 +189,7 @@ def _log_row(log, config, figures, pixels):
         f"{figures['safe_mps']:8.2f}")
 
 
-def run_bench(sizes, configs, filters, runs, *, process=None, log=print):
+def run_bench(sizes, configs, filters, runs, *, log=print):
     """Measure every stage and configuration on generated pairs; return the report.
 
     Parameters
@@ -259,8 +203,6 @@ def run_bench(sizes, configs, filters, runs, *, process=None, log=print):
         ``"threshold"`` and/or ``"gamma"`` (see :func:`bench_image_pair`).
     runs : int
         Timed runs per figure after a warm-up; NumPy gets a third.
-    process : (int, int), optional
-        Also time whole ``aarecovery recover`` processes at this size, with peak memory.
     log : callable
         Gets the report line by line.
 
@@ -270,11 +212,11 @@ def run_bench(sizes, configs, filters, runs, *, process=None, log=print):
         ``machine``, ``gl_renderer``, ``results`` (per filter and size: the decode, plan and
         encode seconds, and per configuration the stage seconds, the passes' megapixels per
         second (classify and passes) and end-to-end megapixels per second for the paper's
-        method and the safe default) and ``process``.
+        method and the safe default).
     """
     from ..params import Parameters
     from ..plan import make_plan
-    report = {"machine": _machine(), "results": []}
+    report = {"machine": machine(), "results": []}
     log(f"machine: {report['machine']}")
     engines = {}
     for config in configs:
@@ -315,9 +257,4 @@ def run_bench(sizes, configs, filters, runs, *, process=None, log=print):
             report["results"].append(row)
     for engine in engines.values():
         engine.release()
-    if process:
-        width, height = process
-        log(f"whole 'aarecovery recover' processes, {width}x{height} thresholded RGB PNG pair, file to file:")
-        report["process"] = _processes(width, height, [config for config in configs if config in _PROCESS_OPTIONS],
-                                       runs, log)
     return report

@@ -30,24 +30,27 @@ _GIGAPIXEL_TILE = 512
 _GIGAPIXEL_BASE = 4096
 
 
-# Runs a command and prints its peak resident memory (bytes) and seconds. In a small Python
-# of its own: a child forked from this (large) process would count this process's pages.
+# Runs a command and prints its peak resident memory (bytes), wall seconds and CPU seconds
+# (user and system, all its threads and children). In a small Python of its own: a child
+# forked from this (large) process would count this process's pages.
 _MEASURE = """
 import resource, subprocess, sys, time
 start = time.perf_counter()
 subprocess.run(sys.argv[1:], check=True, stdout=subprocess.DEVNULL)
 seconds = time.perf_counter() - start
-peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-print(peak if sys.platform == "darwin" else peak * 1024, seconds)
+usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+peak = usage.ru_maxrss
+print(peak if sys.platform == "darwin" else peak * 1024, seconds, usage.ru_utime + usage.ru_stime)
 """
 
 
-def measure_command(command, env=None):
-    """Peak resident memory (bytes) and wall seconds of `command` (a list), run in its own process."""
+def measure_command(command, env=None, cpu=False):
+    """Peak resident memory (bytes) and wall seconds of `command` (a list), run in its own
+    process; with `cpu`, also its CPU seconds (a figure the machine's other jobs move less)."""
     measured = subprocess.run([sys.executable, "-c", _MEASURE, *command], check=True, capture_output=True,
                               text=True, env=env)
-    peak, seconds = measured.stdout.split()
-    return int(peak), float(seconds)
+    peak, seconds, cpu_seconds = measured.stdout.split()
+    return (int(peak), float(seconds), float(cpu_seconds)) if cpu else (int(peak), float(seconds))
 
 
 def _mirrored(start, tile, side):

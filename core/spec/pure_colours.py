@@ -155,7 +155,7 @@ class PureColourPrior:
 
     @property
     def key_code(self):
-        """int: the GL uniform ``table_key`` (0 channel, 1 luma, 2 luma_scale, 3 luminance_scale,
+        """int: the GL define ``TABLE_KEY`` (0 channel, 1 luma, 2 luma_scale, 3 luminance_scale,
         4 luminance, 5 luminance_d50)."""
         return _KEY_CODES[self.key]
 

@@ -16,7 +16,7 @@ Passes (each has a NumPy twin of the same name in ``aarecovery.spec.passes``):
 Passes 1 and 2 cover only the blocks of 16 x 16 pixels where the edge strength can be
 non-zero (``blocks.py``): where F is not flat for the paper's model, where O is not flat with
 pure colours (whose edge strength does not need F's gradient). Pass 3 covers the other
-blocks. The block lists are made on the GPU right after the upload (``classify.py``) and
+blocks. The block lists are made on the GPU when a run first needs them (``classify.py``) and
 drive the draws and dispatches indirectly. On llvmpipe, which shades every covered
 fragment, this is what makes mostly flat results (threshold, posterize) fast; on a GPU it
 saves the work of idle lanes.
@@ -63,7 +63,7 @@ _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("mode
 # The textures made when first needed: (components, dtype); "result" has F's.
 _WORK_TEXTURES = {"original_work": (4, "f4"), "filtered_work": (4, "f4"), "model": (4, "f4"), "edge": (1, "f4"),
                   "local_flat": (1, "f4"), "local_rows": (1, "f4"), "strength_factor": (1, "f4"), "strength": (1, "f4"),
-                  "fixed_a": (4, "f4"), "fixed_b": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4")}
+                  "jacobi_constant": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4")}
 _RESULT_BITS = {np.dtype(np.uint8): 8, np.dtype(np.uint16): 16}
 
 #: How a texture of 1 to 4 channels reads as straight RGBA: the texture unit expands grey
@@ -188,9 +188,9 @@ class GLBackend:
         self._classified = set()
         self._working_lists = set()
         self._ran = None
-        # F's blocks now, while its upload is fresh; O's are needed only with pure colours.
-        self._block_lists("filtered")
-        self._stage("classify")
+        # The blocks are classified when a run first needs them: F's for the paper's model,
+        # O's alone with pure colours (classifying F as well cost 25 x 10-17 ms of CPU in the
+        # 1024 tiles of a 4096 x 4096 thin-feature pair on llvmpipe).
 
     def _configure(self, o_layout, f_layout, linear_input, blend_space):
         """The shader defines and formats for a pair; returns the textures' dtypes for O and F."""
@@ -349,6 +349,8 @@ class GLBackend:
         if local:
             sources["strength_factor"] = self._work("strength_factor")
         defines = {**self._defines, "PURE_COLOURS": int(prior is not None), "LOCAL_STRENGTH": int(local)}
+        if prior is not None:
+            defines.update(self._pure_colour_defines(prior))
         with self._passes():
             if local:
                 self._local_factor(plan.local)
@@ -404,19 +406,22 @@ class GLBackend:
         self._textures["transfer_table"].write(np.ascontiguousarray(prior.table, np.float32))
         return self._textures["transfer_table"]
 
+    @staticmethod
+    def _pure_colour_defines(prior):
+        """The prior's switches, compiled in (pure_colours.glsl says why)."""
+        return dict(TABLE_KEY=prior.key_code, CLAMP_ENDS=int(prior.key_low is not None), TO_CUBE=int(prior.to_cube))
+
     def _pure_colour_uniforms(self, prior):
-        """The palette and the table's keys as uniforms."""
+        """The palette and the table's key range as uniforms."""
         palette = np.zeros((PALETTE_SIZE, 3), np.float32)
         colours = prior.palette_in(self._blend_space)
         palette[:len(colours)] = colours
         low, high = prior.key_range()
-        return dict(table_key=prior.key_code, palette_size=len(colours),
-                    palette=[tuple(map(float, colour)) for colour in palette],
-                    key_low=tuple(map(float, low)), key_high=tuple(map(float, high)),
-                    clamp_ends=int(prior.key_low is not None), to_cube=int(prior.to_cube))
+        return dict(palette_size=len(colours), palette=[tuple(map(float, colour)) for colour in palette],
+                    key_low=tuple(map(float, low)), key_high=tuple(map(float, high)))
 
     def _fit_blend_model(self, sources, uniforms, defines, lists, maps):
-        """The model and the first Jacobi iterate (and the edge map, the fixed pure colours)."""
+        """The model and the first Jacobi iterate (and the edge map, the Jacobi steps' constant with pure colours)."""
         pure = defines["PURE_COLOURS"]
         outputs = [self._work("model"), self._work("iterate_a")]
         if maps:
@@ -426,8 +431,8 @@ class GLBackend:
             self._framebuffer([outputs[2]]).clear(0.0, 0.0, 0.0, 0.0)
         locations = {}
         if pure:
-            outputs += [self._work("fixed_a"), self._work("fixed_b")]
-            locations = dict(FIXED_LOCATION=2 + int(maps), FIXED_LOCATION_B=3 + int(maps))
+            outputs.append(self._work("jacobi_constant"))
+            locations = dict(CONSTANT_LOCATION=2 + int(maps))
         self._path.run_pass("fit_blend_model", sources, outputs, blocks=lists, list_name="active", uniforms=uniforms,
                             defines={**defines, "MAPS": int(maps), "SHARED_TILE": int(self.shared_tile), **locations})
 
@@ -440,7 +445,7 @@ class GLBackend:
         """
         inputs = {**sources, "model_map": self._work("model")}
         if defines["PURE_COLOURS"]:
-            inputs.update(fixed_a_map=self._work("fixed_a"), fixed_b_map=self._work("fixed_b"))
+            inputs["jacobi_constant_map"] = self._work("jacobi_constant")
         previous = self._work("iterate_a") if iterations > 1 else sources["filtered_work"]
         for step in range(2 if iterations > 1 else 1, iterations + 1):
             final = step == iterations

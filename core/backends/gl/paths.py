@@ -39,8 +39,8 @@ __all__ = ["COMPUTE_VERSION", "SAMPLER_UNITS", "FragmentPath", "ComputePath", "c
 COMPUTE_VERSION = 430
 #: The texture unit of every sampler uniform the passes declare.
 SAMPLER_UNITS = {"original_image": 0, "filtered_image": 1, "model_map": 2, "previous_iterate": 3,
-                 "original_work": 4, "filtered_work": 5, "transfer_table": 6, "fixed_a_map": 7, "fixed_b_map": 8,
-                 "strength_factor": 9, "local_input": 10}
+                 "original_work": 4, "filtered_work": 5, "transfer_table": 6, "jacobi_constant_map": 7,
+                 "strength_factor": 8, "local_input": 9}
 
 
 def available_paths(context):

@@ -20,8 +20,8 @@ struct BlendFit {
     vec4 model;           // alpha, beta, the extremes' offsets (+ 81, 162: pure colours), residual
     vec4 first_iterate;   // working space
     float edge;           // edge strength e_p
-    vec4 fixed_a;         // f of the pure colour at extreme a, where the code says so
-    vec4 fixed_b;         // ... and at extreme b
+    vec4 jacobi_constant; // with pure colours: (1 - beta) F plus beta's share of the fixed
+                          // pure colours, the part of every Jacobi step that R does not change
 };
 
 // Roweis EM for one component is power iteration on the 4x4 scatter matrix (see the NumPy
@@ -63,8 +63,6 @@ float confidence(float residual, float edge) {
 
 BlendFit fit_blend_model(ivec2 p, ivec2 size) {
     BlendFit fit;
-    fit.fixed_a = vec4(0.0);
-    fit.fixed_b = vec4(0.0);
     // F first: where F is flat the edge strength is exactly 0, so beta is 0 and the model
     // is never used; skipping the fit there is what makes thresholded and posterized
     // images (mostly flat) fast.
@@ -90,6 +88,7 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
         fit.edge = edge;
         fit.model = vec4(0.5, 0.0, 0.0, 0.0);
         fit.first_iterate = f[0];
+        fit.jacobi_constant = f[0];
         return fit;
     }
 
@@ -137,8 +136,8 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
         float pure_span_sq = dot(pure_span, pure_span);
         alpha = pure_span_sq > TINY ? clamp(dot(c[0] - ext_b.colour, pure_span) / pure_span_sq, 0.0, 1.0) : 0.5;
     }
-    if (ext_a.extended) { f_a = ext_a.filtered; fit.fixed_a = ext_a.filtered; code += 81.0; }
-    if (ext_b.extended) { f_b = ext_b.filtered; fit.fixed_b = ext_b.filtered; code += 162.0; }
+    if (ext_a.extended) { f_a = ext_a.filtered; code += 81.0; }
+    if (ext_b.extended) { f_b = ext_b.filtered; code += 162.0; }
     vec4 contrast_vector = f_a - f_b;
     edge = original_gradient * max(filtered_gradient, sqrt(dot(contrast_vector, contrast_vector)));
 #endif
@@ -149,5 +148,12 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
 #endif
     fit.model = vec4(alpha, beta, code, residual);
     fit.first_iterate = beta * (alpha * f_a + (1.0 - alpha) * f_b) + (1.0 - beta) * f[0];
+#if PURE_COLOURS
+    // Exactly F where beta is 0, as jacobi.glsl needs.
+    vec4 fixed_share = vec4(0.0);
+    if (ext_a.extended) fixed_share += alpha * ext_a.filtered;
+    if (ext_b.extended) fixed_share += (1.0 - alpha) * ext_b.filtered;
+    fit.jacobi_constant = beta * fixed_share + (1.0 - beta) * f[0];
+#endif
     return fit;
 }

@@ -38,8 +38,7 @@ layout(rgba32f, binding = 1) uniform writeonly image2D first_iterate;
 layout(r32f, binding = 2) uniform writeonly image2D edge_map;
 #endif
 #if PURE_COLOURS
-layout(rgba32f, binding = FIXED_LOCATION) uniform writeonly image2D fixed_a;
-layout(rgba32f, binding = FIXED_LOCATION_B) uniform writeonly image2D fixed_b;
+layout(rgba32f, binding = CONSTANT_LOCATION) uniform writeonly image2D jacobi_constant;
 #endif
 
 void main() {
@@ -64,7 +63,6 @@ void main() {
     imageStore(edge_map, p, vec4(fit.edge, 0.0, 0.0, 1.0));
 #endif
 #if PURE_COLOURS
-    imageStore(fixed_a, p, fit.fixed_a);
-    imageStore(fixed_b, p, fit.fixed_b);
+    imageStore(jacobi_constant, p, fit.jacobi_constant);
 #endif
 }

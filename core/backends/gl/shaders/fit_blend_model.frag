@@ -13,8 +13,7 @@ layout(location = 1) out vec4 first_iterate;
 layout(location = 2) out vec4 edge_map;       // edge strength in .r
 #endif
 #if PURE_COLOURS
-layout(location = FIXED_LOCATION) out vec4 fixed_a;
-layout(location = FIXED_LOCATION_B) out vec4 fixed_b;
+layout(location = CONSTANT_LOCATION) out vec4 jacobi_constant;
 #endif
 
 void main() {
@@ -25,7 +24,6 @@ void main() {
     edge_map = vec4(fit.edge, 0.0, 0.0, 1.0);
 #endif
 #if PURE_COLOURS
-    fixed_a = fit.fixed_a;
-    fixed_b = fit.fixed_b;
+    jacobi_constant = fit.jacobi_constant;
 #endif
 }

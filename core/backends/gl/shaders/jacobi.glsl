@@ -4,15 +4,22 @@
 uniform sampler2D model_map;
 uniform sampler2D previous_iterate;
 #if PURE_COLOURS
-uniform sampler2D fixed_a_map;  // f of a thin feature's pure colour, where the model's code says so
-uniform sampler2D fixed_b_map;
+// (1 - beta) F plus beta's share of the fixed pure colours, written by the fit
+// (blend_model.glsl): what each step adds to the gathers of R. It stands in for F, so the
+// step reads as many texels as the paper's (model, constant, two gathers) instead of
+// fetching both fixed colours at every pixel (llvmpipe fetches both sides of a ?:).
+uniform sampler2D jacobi_constant_map;
 #endif
 
 vec4 jacobi_step(ivec2 p, ivec2 size) {
     vec4 model = texelFetch(model_map, p, 0);
     float alpha = model.x;
     float beta = model.y;
+#if PURE_COLOURS
+    vec4 recovered = texelFetch(jacobi_constant_map, p, 0);  // exactly F where beta is 0
+#else
     vec4 recovered = texelFetch(filtered_work, p, 0);
+#endif
     // Most pixels are not edges (beta = 0): they keep F without gathering R.
     if (beta != 0.0) {
         // The extremes' offsets, two base-3 digits each (see blend_model.glsl), decoded in
@@ -25,17 +32,16 @@ vec4 jacobi_step(ivec2 p, ivec2 size) {
 #endif
         vec4 digits = floor((code + 0.5) / vec4(1.0, 3.0, 9.0, 27.0));
         vec4 offsets = digits - 3.0 * floor(digits * (1.0 / 3.0)) - 1.0;  // a.x, a.y, b.x, b.y in -1..1
-        ivec2 at_a_position = clamp_to_image(p + ivec2(offsets.xy), size);
-        ivec2 at_b_position = clamp_to_image(p + ivec2(offsets.zw), size);
+        vec4 at_a = texelFetch(previous_iterate, clamp_to_image(p + ivec2(offsets.xy), size), 0);
+        vec4 at_b = texelFetch(previous_iterate, clamp_to_image(p + ivec2(offsets.zw), size), 0);
 #if PURE_COLOURS
-        vec4 at_a = (pure == 1.0 || pure == 3.0) ? texelFetch(fixed_a_map, p, 0)
-                                                 : texelFetch(previous_iterate, at_a_position, 0);
-        vec4 at_b = pure >= 2.0 ? texelFetch(fixed_b_map, p, 0) : texelFetch(previous_iterate, at_b_position, 0);
+        // A fixed extreme's share is in the constant: its gather gets no weight.
+        float weight_a = (pure == 1.0 || pure == 3.0) ? 0.0 : beta * alpha;
+        float weight_b = pure >= 2.0 ? 0.0 : beta * (1.0 - alpha);
+        recovered = weight_a * at_a + weight_b * at_b + recovered;
 #else
-        vec4 at_a = texelFetch(previous_iterate, at_a_position, 0);
-        vec4 at_b = texelFetch(previous_iterate, at_b_position, 0);
-#endif
         recovered = beta * (alpha * at_a + (1.0 - alpha) * at_b) + (1.0 - beta) * recovered;
+#endif
     }
     return recovered;
 }

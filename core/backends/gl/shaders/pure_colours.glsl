@@ -3,16 +3,30 @@
 // the rule and its measurements. Included after working.glsl, before blend_model.glsl.
 
 uniform sampler2D transfer_table;  // 256 x 1: the filter's table, encoded output per key bin
-uniform int table_key;             // 0: each channel indexes its own column, 1: luma indexes all,
-                                   // 4/5: encoded luminance (Rec. 709 / D50 weights) indexes all,
-                                   // 2/3: luma (encoded) / luminance (linear) mapped by column 0,
-                                   // colour scaled with it (scale_transfer)
 uniform vec3 palette[32];          // O's flat colours, opaque, in the working space
 uniform int palette_size;
 uniform vec3 key_low;              // O's key range (bin centres of the table's first and last
 uniform vec3 key_high;             // filled bins, per column); beyond it the table is extrapolated
-uniform int clamp_ends;            // 1: an extreme at an end of the range reads the table clamped
-uniform int to_cube;               // 0: extend only to a flat colour of O beyond the extreme
+
+// The prior's switches are compile-time defines, not uniforms: llvmpipe runs both sides of
+// every branch under a mask, so a uniform switch paid for every key's sRGB conversions
+// (pow) at every fitted pixel.
+// TABLE_KEY: 0: each channel indexes its own column, 1: luma indexes all,
+//            4/5: encoded luminance (Rec. 709 / D50 weights) indexes all,
+//            2/3: luma (encoded) / luminance (linear) mapped by column 0, colour scaled
+//            with it (scale_transfer)
+// CLAMP_ENDS: 1: an extreme at an end of the range reads the table clamped
+// TO_CUBE: 0: extend only to a flat colour of O beyond the extreme
+#ifndef TABLE_KEY
+#define TABLE_KEY 0
+#endif
+#ifndef CLAMP_ENDS
+#define CLAMP_ENDS 0
+#endif
+#ifndef TO_CUBE
+#define TO_CUBE 1
+#endif
+#define SCALE_KEY (TABLE_KEY == 2 || TABLE_KEY == 3)
 
 const float PALETTE_TOLERANCE = 0.03;
 const float LINE_TOLERANCE = 0.05;
@@ -34,6 +48,16 @@ float table_at(float key, int channel) {
     return below + (above - below) * fraction;
 }
 
+// Every column at one key: two fetches instead of six, the same arithmetic per column.
+vec3 table_row_at(float key) {
+    float position = clamp(key * 256.0 - 0.5, 0.0, 255.0);
+    int lower = min(int(floor(position)), 254);
+    float fraction = position - float(lower);
+    vec3 below = texelFetch(transfer_table, ivec2(lower, 0), 0).rgb;
+    vec3 above = texelFetch(transfer_table, ivec2(lower + 1, 0), 0).rgb;
+    return below + (above - below) * fraction;
+}
+
 vec3 encoded_of(vec4 colour) {
     float coverage = colour.a;
     vec3 straight = clamp(colour.rgb / (coverage > 0.0 ? coverage : 1.0), 0.0, 1.0);
@@ -46,36 +70,35 @@ vec3 encoded_of(vec4 colour) {
 
 // The table keys of an encoded colour, one per table column (key_values).
 vec3 key_values(vec3 encoded) {
-    if (table_key == 0) return encoded;
-    if (table_key == 4 || table_key == 5) {
-        // The encoded value of the luminance of linear light (LUMINANCE_KEYS).
-        vec3 weights = table_key == 4 ? LUMA : LUMINANCE_D50;
-        vec3 lin = srgb_to_linear(encoded);
-        return linear_to_srgb(vec3(lin.r * weights.r + lin.g * weights.g + lin.b * weights.b));
-    }
-    vec3 values = table_key == 3 ? srgb_to_linear(encoded) : encoded;
+#if TABLE_KEY == 0
+    return encoded;
+#elif TABLE_KEY == 4 || TABLE_KEY == 5
+    // The encoded value of the luminance of linear light (LUMINANCE_KEYS).
+    vec3 weights = TABLE_KEY == 4 ? LUMA : LUMINANCE_D50;
+    vec3 lin = srgb_to_linear(encoded);
+    return linear_to_srgb(vec3(lin.r * weights.r + lin.g * weights.g + lin.b * weights.b));
+#else
+    vec3 values = TABLE_KEY == 3 ? srgb_to_linear(encoded) : encoded;
     return vec3(values.r * LUMA.r + values.g * LUMA.g + values.b * LUMA.b);
+#endif
 }
 
-// f of a premultiplied working-space colour, by the table, its keys clamped from below /
-// above to O's key range where low_end / high_end.
-vec4 filtered_colour_clamped(vec4 colour, bvec3 low_end, bvec3 high_end) {
+// f of a premultiplied working-space colour whose encoded colour and (clamped) table keys
+// are known.
+vec4 filtered_colour_of(vec4 colour, vec3 encoded, vec3 keys) {
     float coverage = colour.a;
-    vec3 encoded = encoded_of(colour);
-    vec3 keys = key_values(encoded);
-    keys = mix(keys, max(keys, key_low), vec3(low_end));
-    keys = mix(keys, min(keys, key_high), vec3(high_end));
-    vec3 out_colour;
-    if (table_key == 2 || table_key == 3) {
-        vec3 values = table_key == 3 ? srgb_to_linear(encoded) : encoded;
-        float luma = values.r * LUMA.r + values.g * LUMA.g + values.b * LUMA.b;
-        float mapped = table_at(keys.r, 0);
-        vec3 scaled = luma > 1e-6 ? values * (mapped / luma) : vec3(mapped);
-        scaled = clamp(scaled, 0.0, 1.0);
-        out_colour = table_key == 3 ? linear_to_srgb(scaled) : scaled;
-    } else {
-        out_colour = vec3(table_at(keys.r, 0), table_at(keys.g, 1), table_at(keys.b, 2));
-    }
+#if SCALE_KEY
+    vec3 values = TABLE_KEY == 3 ? srgb_to_linear(encoded) : encoded;
+    float luma = values.r * LUMA.r + values.g * LUMA.g + values.b * LUMA.b;
+    float mapped = table_at(keys.r, 0);
+    vec3 scaled = luma > 1e-6 ? values * (mapped / luma) : vec3(mapped);
+    scaled = clamp(scaled, 0.0, 1.0);
+    vec3 out_colour = TABLE_KEY == 3 ? linear_to_srgb(scaled) : scaled;
+#elif TABLE_KEY == 0
+    vec3 out_colour = vec3(table_at(keys.r, 0), table_at(keys.g, 1), table_at(keys.b, 2));
+#else
+    vec3 out_colour = table_row_at(keys.r);  // one key for all columns
+#endif
 #if WORK_IS_LINEAR
     vec3 decoded = srgb_to_linear(clamp(out_colour, 0.0, 1.0));
 #else
@@ -84,9 +107,14 @@ vec4 filtered_colour_clamped(vec4 colour, bvec3 low_end, bvec3 high_end) {
     return vec4(decoded * coverage, coverage);
 }
 
-// f of a premultiplied working-space colour, by the table.
-vec4 filtered_colour(vec4 colour) {
-    return filtered_colour_clamped(colour, bvec3(false), bvec3(false));
+// f of a premultiplied working-space colour, by the table, its keys clamped from below /
+// above to O's key range where low_end / high_end.
+vec4 filtered_colour_clamped(vec4 colour, bvec3 low_end, bvec3 high_end) {
+    vec3 encoded = encoded_of(colour);
+    vec3 keys = key_values(encoded);
+    keys = mix(keys, max(keys, key_low), vec3(low_end));
+    keys = mix(keys, min(keys, key_high), vec3(high_end));
+    return filtered_colour_of(colour, encoded, keys);
 }
 
 // Both pixels lie on the colour line and are less extreme than `limit` along it.
@@ -115,15 +143,27 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
     float len = sqrt(dot(span, span));
     if (!(len > 1e-6)) return result;
     // Extremes within an 8-bit gradient's noise of each other are not a thin feature.
-    vec3 steps = abs(encoded_of(far) - encoded_of(near));
+    vec3 far_encoded = encoded_of(far);
+    vec3 near_encoded = encoded_of(near);
+    vec3 steps = abs(far_encoded - near_encoded);
     if (!(max(max(max(steps.r, steps.g), steps.b), abs(span.a)) >= MIN_CONTRAST)) return result;
     if (q.x <= 0 || q.y <= 0 || q.x >= size.x - 1 || q.y >= size.y - 1) return result;
+    float tolerance_sq = PALETTE_TOLERANCE * PALETTE_TOLERANCE;
+    // One loop over the palette for both extremes (a loop costs its full length on llvmpipe,
+    // whatever its early exits).
+    bool far_pure = false, near_pure = false;
     for (int i = 0; i < palette_size; ++i) {
         vec3 miss = far.rgb - palette[i] * far.a;
-        if (!(miss.r * miss.r + miss.g * miss.g + miss.b * miss.b >= PALETTE_TOLERANCE * PALETTE_TOLERANCE))
-            return result;
+        far_pure = far_pure || !(miss.r * miss.r + miss.g * miss.g + miss.b * miss.b >= tolerance_sq);
+#if CLAMP_ENDS
+        vec3 near_miss = near.rgb - palette[i] * near.a;
+        near_pure = near_pure || near_miss.r * near_miss.r + near_miss.g * near_miss.g
+                                 + near_miss.b * near_miss.b < tolerance_sq;
+#endif
     }
-    vec4 explained = abs(filtered_colour(far) - filtered_far);
+    if (far_pure) return result;
+    vec3 far_keys = key_values(far_encoded);
+    vec4 explained = abs(filtered_colour_of(far, far_encoded, far_keys) - filtered_far);
     if (!(max(max(explained.r, explained.g), explained.b) < EXPLAIN_TOLERANCE)) return result;
     vec4 direction = span / len;
     float t_far = dot(far - near, direction);
@@ -135,23 +175,16 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
               || lower_pair(q + OFFSETS[5], q + OFFSETS[8], near, direction, t_far - margin, size)
               || lower_pair(q + OFFSETS[6], q + OFFSETS[7], near, direction, t_far - margin, size);
     if (!ridge) return result;
+#if CLAMP_ENDS
     // An extreme that is O's darkest or brightest colour is pure (a paper between thin lines),
     // unless the other extreme is the opposite end or a flat colour (spec/pure_colours.extend_extreme).
-    if (clamp_ends != 0) {
-        vec3 far_keys = key_values(encoded_of(far));
-        vec3 near_keys = key_values(encoded_of(near));
-        bool far_low = all(lessThanEqual(far_keys, key_low + END_TOLERANCE));
-        bool far_high = all(greaterThanEqual(far_keys, key_high - END_TOLERANCE));
-        bool near_low = all(lessThanEqual(near_keys, key_low + END_TOLERANCE));
-        bool near_high = all(greaterThanEqual(near_keys, key_high - END_TOLERANCE));
-        bool near_pure = false;
-        for (int i = 0; i < palette_size; ++i) {
-            vec3 miss = near.rgb - palette[i] * near.a;
-            near_pure = near_pure || (miss.r * miss.r + miss.g * miss.g + miss.b * miss.b
-                                      < PALETTE_TOLERANCE * PALETTE_TOLERANCE);
-        }
-        if (((far_low && !near_high) || (far_high && !near_low)) && !near_pure) return result;
-    }
+    vec3 near_keys = key_values(near_encoded);
+    bool far_low = all(lessThanEqual(far_keys, key_low + END_TOLERANCE));
+    bool far_high = all(greaterThanEqual(far_keys, key_high - END_TOLERANCE));
+    bool near_low = all(lessThanEqual(near_keys, key_low + END_TOLERANCE));
+    bool near_high = all(greaterThanEqual(near_keys, key_high - END_TOLERANCE));
+    if (((far_low && !near_high) || (far_high && !near_low)) && !near_pure) return result;
+#endif
     // Largest s >= 1 with near + s span inside the premultiplied cube 0 <= rgb <= alpha <= 1.
     float reach = 1e6;
     for (int c = 0; c < 4; ++c) {
@@ -172,18 +205,20 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
             nearest = min(nearest, along / len);
     }
     if (nearest < 1e5) reach = min(nearest, reach);
-    else if (to_cube == 0) return result;
+#if !TO_CUBE
+    else return result;
+#endif
     if (!(reach > MIN_REACH)) return result;  // the extreme is the ink itself
     result.extended = true;
     result.colour = near + reach * span;
     // At an end of O's key range the extreme is read with the table clamped there (a dark
     // paper, not unseen ink: spec/pure_colours.extend_extreme).
+#if CLAMP_ENDS
+    bvec3 low_end = lessThanEqual(far_keys, key_low + RANGE_TOLERANCE);
+    bvec3 high_end = greaterThanEqual(far_keys, key_high - RANGE_TOLERANCE);
+#else
     bvec3 low_end = bvec3(false), high_end = bvec3(false);
-    if (clamp_ends != 0) {
-        vec3 far_keys = key_values(encoded_of(far));
-        low_end = lessThanEqual(far_keys, key_low + RANGE_TOLERANCE);
-        high_end = greaterThanEqual(far_keys, key_high - RANGE_TOLERANCE);
-    }
+#endif
     result.filtered = filtered_colour_clamped(result.colour, low_end, high_end);
     return result;
 }
