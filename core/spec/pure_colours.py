@@ -138,6 +138,11 @@ class PureColourPrior:
         cube (two colours fit any key), so that f there is a guess, and where F is an affine
         function of the table's key on O's edges (``aarecovery.plan.pure_colours``), so
         that the guess could only add its own error.
+    explain_filtered : bool
+        The table must reproduce F at the observed extreme (:data:`EXPLAIN_TOLERANCE`): true
+        for a fitted point-wise table. False for a neighbourhood filter that keeps flat
+        colours (``aarecovery.plan.flat_colours``): its table is what it does to a flat
+        area, and F at a thin feature differs from that by the very damage to repair.
     """
 
     key: str
@@ -146,6 +151,7 @@ class PureColourPrior:
     key_low: np.ndarray = None
     key_high: np.ndarray = None
     to_cube: bool = True
+    explain_filtered: bool = True
 
     def key_range(self):
         """Observed key range (bin centres of the first and last filled bins), each shape (3,)."""
@@ -316,10 +322,11 @@ def extend_extreme(far, near, around, filtered_far, on_border, palette, prior, b
         miss = far[:3] - colour[:, None] * far[3]
         candidate &= miss[0] * miss[0] + miss[1] * miss[1] + miss[2] * miss[2] \
             >= np.float32(PALETTE_TOLERANCE * PALETTE_TOLERANCE)
-    # The table must explain F at the observed extreme.
-    explained = filtered_colour(far, prior, blend_space)
-    miss = np.abs(explained - filtered_far)[:3].max(axis=0)
-    candidate &= miss < np.float32(EXPLAIN_TOLERANCE)
+    # A fitted table must explain F at the observed extreme.
+    if prior.explain_filtered:
+        explained = filtered_colour(far, prior, blend_space)
+        miss = np.abs(explained - filtered_far)[:3].max(axis=0)
+        candidate &= miss < np.float32(EXPLAIN_TOLERANCE)
     # Largest s >= 1 with near + s (far - near) inside the premultiplied colour cube:
     # 0 <= rgb <= alpha <= 1.
     reach = np.full(length.shape, np.float32(1e6))

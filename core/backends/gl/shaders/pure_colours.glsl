@@ -13,6 +13,7 @@ uniform vec3 key_low;              // O's key range (bin centres of the table's 
 uniform vec3 key_high;             // filled bins, per column); beyond it the table is extrapolated
 uniform int clamp_ends;            // 1: an extreme at an end of the range reads the table clamped
 uniform int to_cube;               // 0: extend only to a flat colour of O beyond the extreme
+uniform int explain_filtered;      // 1: the table must reproduce F at the extreme (a fitted table)
 
 const float PALETTE_TOLERANCE = 0.03;
 const float LINE_TOLERANCE = 0.05;
@@ -123,8 +124,10 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
         if (!(miss.r * miss.r + miss.g * miss.g + miss.b * miss.b >= PALETTE_TOLERANCE * PALETTE_TOLERANCE))
             return result;
     }
-    vec4 explained = abs(filtered_colour(far) - filtered_far);
-    if (!(max(max(explained.r, explained.g), explained.b) < EXPLAIN_TOLERANCE)) return result;
+    if (explain_filtered != 0) {
+        vec4 explained = abs(filtered_colour(far) - filtered_far);
+        if (!(max(max(explained.r, explained.g), explained.b) < EXPLAIN_TOLERANCE)) return result;
+    }
     vec4 direction = span / len;
     float t_far = dot(far - near, direction);
     float margin = RIDGE_MARGIN * len;
