@@ -98,6 +98,21 @@ def test_thin_lines_darkened_by_sharpening_are_restored():
     assert np.abs(recovered[line] - original[line]).max() < 0.05
 
 
+def test_an_erased_or_recoloured_thin_feature_is_not_extended():
+    # Edge-aware smoothing that erases a thin line meant to (its reference has it erased);
+    # a hue change moves it off O's colour line. Neither is extended to the ink.
+    original = thin_lines()
+    filtered = sharpened(original)
+    prior, _ = flat_colour_prior(original, filtered, edges_of(original))
+    erased, recoloured = filtered.copy(), filtered.copy()
+    erased[24:26, 4:36] = 0.97
+    recoloured[24:26, 4:36] = (0.9, 0.1, 0.1)
+    work_o = to_working_space(rgba(original))
+    for changed in (erased, recoloured):
+        _, model = recover_working(work_o, to_working_space(rgba(changed)), 0.1, 0.01, 3, 1.0, prior, "linear")
+        assert not (model.pure_a[21:27, 8:28].any() or model.pure_b[21:27, 8:28].any())
+
+
 def test_without_the_explain_test_the_extension_reaches_a_damaged_extreme():
     # The same prior with the point-wise rule (F must equal f(extreme)) extends nothing here,
     # since F at the thin line is its damage, not f of its colour.

@@ -19,6 +19,8 @@ const float PALETTE_TOLERANCE = 0.03;
 const float LINE_TOLERANCE = 0.05;
 const float RIDGE_MARGIN = 0.1001;
 const float EXPLAIN_TOLERANCE = 0.02;
+const float ON_LINE_TOLERANCE = 0.15;
+const float KEPT_CONTRAST = 0.5;
 const float RANGE_TOLERANCE = 0.05;
 const float END_TOLERANCE = 1.0 / 255.0;
 const float MIN_CONTRAST = 8.5 / 255.0;
@@ -129,6 +131,13 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
         if (!(max(max(explained.r, explained.g), explained.b) < EXPLAIN_TOLERANCE)) return result;
     }
     vec4 direction = span / len;
+    if (explain_filtered == 0) {
+        // No fitted table: F at the extreme lies on O's colour line and keeps the contrast.
+        vec4 moved = filtered_far - near;
+        float moved_along = dot(moved, direction);
+        if (!(dot(moved, moved) - moved_along * moved_along < ON_LINE_TOLERANCE * ON_LINE_TOLERANCE)
+            || !(moved_along >= KEPT_CONTRAST * len)) return result;
+    }
     float t_far = dot(far - near, direction);
     float margin = RIDGE_MARGIN * len;
     // Opposite pairs of q's neighbours, N/S, W/E, NW/SE, NE/SW, written out: indexing an
