@@ -14,9 +14,9 @@ not asked to agree with that table: it differs by the damage the passes repair.
 
 Measured on the real-tools suite, drawings with PNG originals, neighbourhood filters on
 hard-edged content (the paper's passes at full strength before): tuning half mean
-edge-band error reduction 0.455 -> 0.678 (GEGL's unsharp mask 0.544 -> 0.788, G'MIC's
-bilateral 0.342 -> 0.486, ImageMagick's unsharp 0.478 -> 0.761); held-out half G'MIC's
-unsharp 0.433 -> 0.821. Extending only to a flat colour of O beyond the extreme (not to
+edge-band error reduction 0.455 -> 0.673 (GEGL's unsharp mask 0.544 -> 0.781, G'MIC's
+bilateral 0.343 -> 0.476, ImageMagick's unsharp 0.478 -> 0.763); held-out half G'MIC's
+unsharp 0.433 -> 0.831. Extending only to a flat colour of O beyond the extreme (not to
 the cube) gave 0.464: the ink of thin lines is rarely seen flat.
 
 The identity is the filter's table only where the filter keeps colours: it must keep O's
