@@ -16,6 +16,8 @@ TWINS = {
     ("pure_colours.glsl", "LINE_TOLERANCE"): pure_colours.LINE_TOLERANCE,
     ("pure_colours.glsl", "RIDGE_MARGIN"): pure_colours.RIDGE_MARGIN,
     ("pure_colours.glsl", "EXPLAIN_TOLERANCE"): pure_colours.EXPLAIN_TOLERANCE,
+    ("pure_colours.glsl", "ON_LINE_TOLERANCE"): pure_colours.ON_LINE_TOLERANCE,
+    ("pure_colours.glsl", "KEPT_CONTRAST"): pure_colours.KEPT_CONTRAST,
     ("pure_colours.glsl", "RANGE_TOLERANCE"): pure_colours.RANGE_TOLERANCE,
     ("pure_colours.glsl", "END_TOLERANCE"): pure_colours.END_TOLERANCE,
     ("pure_colours.glsl", "MIN_CONTRAST"): pure_colours.MIN_CONTRAST,

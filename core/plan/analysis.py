@@ -47,6 +47,7 @@ from ..spec.sobel import gradient_magnitude
 from .blend_space import choose_blend_space
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
+from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
 from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
@@ -213,8 +214,13 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                         f"no larger than the model's own error (ratio {ratio:.2f} < "
                                         f"{MIN_REPAIR_TO_ERROR:g}): kept F", Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT,
                             forcing=forcing_advice(Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT, ratio))
+    # Filters that keep flat colours (sharpening, edge-aware smoothing): thin features get
+    # their pure colours with the identity as the table (plan/flat_colours.py).
+    prior, kept = flat_colour_prior(o, f, edges)
     return PairAnalysis(space, 1.0, f"neighbourhood filter on hard-edged content (repair-to-error ratio "
-                                    f"{ratio:.1f}): full strength", Decision.NEIGHBOURHOOD_HARD_EDGED)
+                                    f"{ratio:.1f}): full strength"
+                                    + (f", pure colours of thin features ({kept})" if prior is not None else ""),
+                        Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
 
 
 def _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e):

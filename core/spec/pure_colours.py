@@ -59,7 +59,7 @@ from .blend_model import BlendModel, confidence, coverage, fit_extremes
 from .neighbourhood import NEIGHBOUR_OFFSETS, dot, neighbours, planes
 from .sobel import sobel_magnitude
 
-__all__ = ["PureColourPrior", "PALETTE_SIZE", "EXTENSION_KEYS", "SCALE_KEYS", "filtered_colour", "extend_extreme",
+__all__ = ["PureColourPrior", "PALETTE_SIZE", "ON_LINE_TOLERANCE", "KEPT_CONTRAST", "EXTENSION_KEYS", "SCALE_KEYS", "filtered_colour", "extend_extreme",
            "scale_transfer", "key_values", "fit_pure_colour_model"]
 
 #: Most palette colours kept (a uniform array in the GL pass).
@@ -83,6 +83,16 @@ RIDGE_MARGIN = 0.1001
 MIN_REACH = 1.2
 # The table must reproduce F at the observed extreme within this (working space).
 EXPLAIN_TOLERANCE = 0.02
+#: Without a fitted table (a neighbourhood filter that keeps flat colours), F at the extreme
+#: must lie within this of O's colour line through the two extremes (working space): the
+#: built-in colour replacement of sRGB text reached that plan and lost 0.79 -> -2.0 without
+#: it; per-channel clipping of overshoot moves F off the line a little (real-tools tuning
+#: half, neighbourhood filters on drawings: 0.628 at 0.05, 0.658 at 0.1, 0.673 at 0.15).
+ON_LINE_TOLERANCE = 0.15
+#: ... and keep at least this share of the extremes' contrast in O along that line: the
+#: built-in bilateral filter erases thin sRGB text, and so does its reference; extending it
+#: lost 0.33 -> -0.67, with this test 0.79.
+KEPT_CONTRAST = 0.5
 #: An extreme is tested only when it differs from the other extreme by more than 8 levels of
 #: an 8-bit image in some encoded channel or in alpha. Below that the two extremes of a
 #: smooth gradient's quantisation noise (O stepping by 1-2 levels, F flat after a threshold)
@@ -138,6 +148,11 @@ class PureColourPrior:
         cube (two colours fit any key), so that f there is a guess, and where F is an affine
         function of the table's key on O's edges (``aarecovery.plan.pure_colours``), so
         that the guess could only add its own error.
+    explain_filtered : bool
+        The table must reproduce F at the observed extreme (:data:`EXPLAIN_TOLERANCE`): true
+        for a fitted point-wise table. False for a neighbourhood filter that keeps flat
+        colours (``aarecovery.plan.flat_colours``): its table is what it does to a flat
+        area, and F at a thin feature differs from that by the very damage to repair.
     """
 
     key: str
@@ -146,6 +161,7 @@ class PureColourPrior:
     key_low: np.ndarray = None
     key_high: np.ndarray = None
     to_cube: bool = True
+    explain_filtered: bool = True
 
     def key_range(self):
         """Observed key range (bin centres of the first and last filled bins), each shape (3,)."""
@@ -316,10 +332,19 @@ def extend_extreme(far, near, around, filtered_far, on_border, palette, prior, b
         miss = far[:3] - colour[:, None] * far[3]
         candidate &= miss[0] * miss[0] + miss[1] * miss[1] + miss[2] * miss[2] \
             >= np.float32(PALETTE_TOLERANCE * PALETTE_TOLERANCE)
-    # The table must explain F at the observed extreme.
-    explained = filtered_colour(far, prior, blend_space)
-    miss = np.abs(explained - filtered_far)[:3].max(axis=0)
-    candidate &= miss < np.float32(EXPLAIN_TOLERANCE)
+    # A fitted table must explain F at the observed extreme. Without one, F there must lie on
+    # O's colour line (sharpening moves a thin feature along it; a hue change moves it off,
+    # and the identity table would undo the change) and keep the feature's contrast (an
+    # edge-aware smoothing that erased it meant to, and its reference has it erased too).
+    if prior.explain_filtered:
+        explained = filtered_colour(far, prior, blend_space)
+        miss = np.abs(explained - filtered_far)[:3].max(axis=0)
+        candidate &= miss < np.float32(EXPLAIN_TOLERANCE)
+    else:
+        moved = filtered_far - near
+        along = dot(moved, direction)
+        candidate &= (dot(moved, moved) - along * along < np.float32(ON_LINE_TOLERANCE * ON_LINE_TOLERANCE)) \
+            & (along >= np.float32(KEPT_CONTRAST) * length)
     # Largest s >= 1 with near + s (far - near) inside the premultiplied colour cube:
     # 0 <= rgb <= alpha <= 1.
     reach = np.full(length.shape, np.float32(1e6))

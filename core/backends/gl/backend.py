@@ -409,7 +409,8 @@ class GLBackend:
     @staticmethod
     def _pure_colour_defines(prior):
         """The prior's switches, compiled in (pure_colours.glsl says why)."""
-        return dict(TABLE_KEY=prior.key_code, CLAMP_ENDS=int(prior.key_low is not None), TO_CUBE=int(prior.to_cube))
+        return dict(TABLE_KEY=prior.key_code, CLAMP_ENDS=int(prior.key_low is not None), TO_CUBE=int(prior.to_cube),
+                    EXPLAIN_FILTERED=int(prior.explain_filtered))
 
     def _pure_colour_uniforms(self, prior):
         """The palette and the table's key range as uniforms."""

@@ -26,12 +26,20 @@ uniform vec3 key_high;             // filled bins, per column); beyond it the ta
 #ifndef TO_CUBE
 #define TO_CUBE 1
 #endif
+// EXPLAIN_FILTERED: 1: the table must reproduce F at the extreme (a fitted table); 0: the
+//            identity table of a neighbourhood filter that keeps flat colours, where F at the
+//            extreme must instead stay on O's colour line and keep its contrast
+#ifndef EXPLAIN_FILTERED
+#define EXPLAIN_FILTERED 1
+#endif
 #define SCALE_KEY (TABLE_KEY == 2 || TABLE_KEY == 3)
 
 const float PALETTE_TOLERANCE = 0.03;
 const float LINE_TOLERANCE = 0.05;
 const float RIDGE_MARGIN = 0.1001;
 const float EXPLAIN_TOLERANCE = 0.02;
+const float ON_LINE_TOLERANCE = 0.15;
+const float KEPT_CONTRAST = 0.5;
 const float RANGE_TOLERANCE = 0.05;
 const float END_TOLERANCE = 1.0 / 255.0;
 const float MIN_CONTRAST = 8.5 / 255.0;
@@ -163,9 +171,18 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
     }
     if (far_pure) return result;
     vec3 far_keys = key_values(far_encoded);
+#if EXPLAIN_FILTERED
     vec4 explained = abs(filtered_colour_of(far, far_encoded, far_keys) - filtered_far);
     if (!(max(max(explained.r, explained.g), explained.b) < EXPLAIN_TOLERANCE)) return result;
+#endif
     vec4 direction = span / len;
+#if !EXPLAIN_FILTERED
+    // No fitted table: F at the extreme lies on O's colour line and keeps the contrast.
+    vec4 moved = filtered_far - near;
+    float moved_along = dot(moved, direction);
+    if (!(dot(moved, moved) - moved_along * moved_along < ON_LINE_TOLERANCE * ON_LINE_TOLERANCE)
+        || !(moved_along >= KEPT_CONTRAST * len)) return result;
+#endif
     float t_far = dot(far - near, direction);
     float margin = RIDGE_MARGIN * len;
     // Opposite pairs of q's neighbours, N/S, W/E, NW/SE, NE/SW, written out: indexing an
