@@ -5,6 +5,7 @@ writes atomically in what the extension's format holds.
 """
 
 from .formats import WRITE_FORMATS
+from .jpeg import read_quantization
 from .limits import DEFAULT_MAX_BYTES, check_decoded_size
 from .parts import remove_stale_parts
 from .read import orientation_tag, read_image
@@ -12,4 +13,4 @@ from .write import DiskError, check_output_path, check_writable_folder, write_im
 
 __all__ = ["read_image", "write_image", "write_images", "check_output_path", "check_writable_folder",
            "remove_stale_parts", "DiskError", "WRITE_FORMATS", "DEFAULT_MAX_BYTES", "check_decoded_size",
-           "orientation_tag"]
+           "orientation_tag", "read_quantization"]

@@ -33,6 +33,7 @@ from ..spec.sobel import gradient_magnitude
 from .blend_space import choose_blend_space
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
+from .compression import compression_evidence
 from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
@@ -82,19 +83,20 @@ def analysis_crop(image):
     return image[top:top + _ANALYSIS_SIDE, left:left + _ANALYSIS_SIDE]
 
 
-def analyse_pair(original, filtered, linear=False):
+def analyse_pair(original, filtered, linear=False, quantization=None):
     """:func:`analyse` on a pair as the caller gave it (any layout and dtype of the contract).
 
     Only the crop is converted to float: a 20000 x 20000 pair would otherwise take 13 GB
-    just for the conversion.
+    just for the conversion. `quantization`: the tables of O's JPEG file, as for :func:`analyse`.
     """
     o_crop, f_crop = analysis_crop(original), analysis_crop(filtered)
     return analyse(to_rgba_float(o_crop, layout_of(o_crop, "original"), "original"),
-                   to_rgba_float(f_crop, layout_of(f_crop, "filtered"), "filtered"), linear_input=bool(linear))
+                   to_rgba_float(f_crop, layout_of(f_crop, "filtered"), "filtered"), linear_input=bool(linear),
+                   quantization=quantization)
 
 
 def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default,
-            iterations=ITERATIONS.default):
+            iterations=ITERATIONS.default, quantization=None):
     """Decide blend space, strength and pure colours for one pair (the safe default).
 
     Parameters
@@ -106,6 +108,9 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     sigma_d, sigma_e, iterations
         The parameters the calibration runs at (the paper's: the analysis is a property of
         the pair, so that a slider change never re-runs it).
+    quantization : sequence of sequence of int, optional
+        The quantization tables of O's JPEG file (``aarecovery.io.read_quantization``); without
+        them O's pixels are searched for a JPEG block grid (``aarecovery.plan.compression``).
 
     Returns
     -------
@@ -128,6 +133,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                         "so its edges are already right: kept F")
     transfer = fit_pointwise(o, f, edges)
     textured, texture = is_textured(o, fit)
+    compression = compression_evidence(o, quantization)
     if transfer.consistency >= POINTWISE_SHARE and not textured:
         # Hard-edged content: calibration would be biased here, since O is not a sharp
         # scene at twice the resolution (its edges are already blends) and box2(F) keeps
@@ -136,10 +142,12 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # With a monotone per-channel or luma table, thin features get their pure colours:
         # quick suite 0.600 -> 0.712 (linear), 0.628 -> 0.686 (sRGB); the table's ends
         # extended by a power law: 0.774 / 0.734.
-        prior = pure_colour_prior(o, transfer, space, f, edges)
+        prior = pure_colour_prior(o, transfer, space, f, edges, noise_contrast=compression.contrast)
         return PairAnalysis(space, 1.0, f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges "
                                         "match) on hard-edged content: full strength"
-                                        + (", pure colours of thin features" if prior is not None else ""), prior)
+                                        + (", pure colours of thin features" if prior is not None else "")
+                                        + (f" above {compression.describe()}" if compression.compressed else ""),
+                            prior)
     if transfer.consistency >= POINTWISE_SHARE:
         strength, _ = calibrate_strength(o, transfer, f, space, sigma_d, sigma_e, iterations)
         return PairAnalysis(space, strength,

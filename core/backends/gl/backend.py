@@ -381,7 +381,8 @@ class GLBackend:
         return dict(table_key=prior.key_code, palette_size=len(colours),
                     palette=[tuple(map(float, colour)) for colour in palette],
                     key_low=tuple(map(float, low)), key_high=tuple(map(float, high)),
-                    clamp_ends=int(prior.key_low is not None), to_cube=int(prior.to_cube))
+                    clamp_ends=int(prior.key_low is not None), to_cube=int(prior.to_cube),
+                    noise_contrast=float(prior.noise_contrast))
 
     def _fit_blend_model(self, sources, uniforms, defines, lists, maps):
         """The model and the first Jacobi iterate (and the edge map, the fixed pure colours)."""

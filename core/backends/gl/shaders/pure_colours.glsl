@@ -13,6 +13,7 @@ uniform vec3 key_low;              // O's key range (bin centres of the table's 
 uniform vec3 key_high;             // filled bins, per column); beyond it the table is extrapolated
 uniform int clamp_ends;            // 1: an extreme at an end of the range reads the table clamped
 uniform int to_cube;               // 0: extend only to a flat colour of O beyond the extreme
+uniform float noise_contrast;      // O's compression noise as a contrast (0: not compressed)
 
 const float PALETTE_TOLERANCE = 0.03;
 const float LINE_TOLERANCE = 0.05;
@@ -114,9 +115,9 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
     vec4 span = far - near;
     float len = sqrt(dot(span, span));
     if (!(len > 1e-6)) return result;
-    // Extremes within an 8-bit gradient's noise of each other are not a thin feature.
+    // Extremes within an 8-bit gradient's (or a JPEG's) noise of each other are not a thin feature.
     vec3 steps = abs(encoded_of(far) - encoded_of(near));
-    if (!(max(max(max(steps.r, steps.g), steps.b), abs(span.a)) >= MIN_CONTRAST)) return result;
+    if (!(max(max(max(steps.r, steps.g), steps.b), abs(span.a)) >= max(MIN_CONTRAST, noise_contrast))) return result;
     if (q.x <= 0 || q.y <= 0 || q.x >= size.x - 1 || q.y >= size.y - 1) return result;
     for (int i = 0; i < palette_size; ++i) {
         vec3 miss = far.rgb - palette[i] * far.a;

@@ -1,0 +1,37 @@
+"""What a JPEG file says about its own compression: its quantization tables.
+
+The safe default reads the compression noise of O from them
+(``aarecovery.plan.compression``); an image given as an array has no file, and the plan
+searches its pixels for the block grid instead. Pillow parses the tables with the header,
+without decoding the pixels.
+"""
+
+from PIL import Image, UnidentifiedImageError
+
+__all__ = ["read_quantization"]
+
+
+def read_quantization(path):
+    """The quantization tables of a JPEG file, or None for any other file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    list of list of int or None
+        64 steps per table, luma first, as Pillow gives them (the noise bound does not
+        depend on the order of the steps), or None when the file is not a JPEG (a PNG, a TIFF: no compression noise)
+        or cannot be opened as an image (``read_image`` reports that).
+    """
+    try:
+        with Image.open(path) as image:
+            if image.format != "JPEG":
+                return None
+            tables = getattr(image, "quantization", None)
+    except (OSError, UnidentifiedImageError, ValueError):
+        return None
+    if not tables:
+        return None
+    return [list(tables[key]) for key in sorted(tables)]
