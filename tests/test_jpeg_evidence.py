@@ -93,6 +93,16 @@ def test_the_command_line_passes_a_jpeg_files_tables_to_the_plan(tmp_path, capsy
         engine.release()
 
 
+def test_a_batch_reads_the_tables_of_jpeg_originals(tmp_path):
+    _, jpeg, data = scan_page(7, 75)
+    (tmp_path / "o.jpg").write_bytes(data)
+    Image.fromarray(threshold(jpeg)).save(tmp_path / "f.png")
+    from_file, from_array = aarecovery.recover_many([(tmp_path / "o.jpg", tmp_path / "f.png", "file.png"),
+                                                     (jpeg, threshold(jpeg), "array.png")], backend="numpy")
+    assert "JPEG (quantization tables" in from_file.reason
+    assert "JPEG (block grid" in from_array.reason
+
+
 def _pages(count, seed):
     rng = np.random.default_rng(seed)
     for index in range(count):
@@ -118,3 +128,33 @@ def test_without_the_noise_contrast_the_grain_does_reach_the_background(monkeypa
     assert NOISE_CONTRAST_SIGMAS > 0
     monkeypatch.setattr(compression, "NOISE_CONTRAST_SIGMAS", 0.0)
     assert haze(aarecovery.recover(jpeg, filtered, backend="numpy"), filtered, png) > 100
+
+
+def _jpeg_round_trip(pixels, quality):
+    buffer = io.BytesIO()
+    Image.fromarray(pixels).save(buffer, format="JPEG", quality=quality)
+    buffer.seek(0)
+    with Image.open(buffer) as decoded:
+        return np.asarray(decoded.convert("RGB"))
+
+
+@pytest.mark.parametrize("quality", [75, 90])
+def test_a_jpeg_drawing_is_hard_edged_and_a_jpeg_photo_textured(quality):
+    # The pixel grain reads a JPEG page's ringing as texture; the edge-free blocks of its
+    # grid are flat, where a photo's keep their shading.
+    from importlib import resources
+
+    from aarecovery.lab.realtools import render_family
+    from aarecovery.plan.resample import box_downsample
+    from aarecovery.plan.texture import grain, is_textured
+    page = np.rint(box_downsample(render_family("serif", 96), 8, "linear") * 255).astype(np.uint8)
+    page = _encoded(_jpeg_round_trip(page, quality))
+    evidence = compression_evidence(page)
+    assert grain(page) > 0.05
+    assert is_textured(page, 0.0, evidence) == (False, is_textured(page, 0.0, evidence)[1])
+    with resources.files("aarecovery").joinpath("data/photo_camera.png").open("rb") as handle:
+        photo = np.asarray(Image.open(handle).convert("RGB"))[:256, :256]
+    photo = _encoded(_jpeg_round_trip(np.ascontiguousarray(photo[::2, ::2]), quality))
+    evidence = compression_evidence(photo)
+    assert evidence.compressed
+    assert is_textured(photo, 0.0, evidence)[0]

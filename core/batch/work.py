@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, fields
 from .. import stream
 from ..contract import check_same_size, check_values, layout_of
 from ..errors import InputError
-from ..io import check_output_path, read_image, write_image
+from ..io import check_output_path, read_image, read_quantization, write_image
 from ..io.maps import write_maps
 from ..params import Parameters
 from ..pipeline import recover
@@ -317,8 +317,10 @@ def _prepare(work, settings, capabilities, started, planner):
         if work.output is not None:
             check_output_path(work.target, f_layout.shape)
         work.original, work.filtered = original, filtered
+        # A JPEG original's tables bound its compression noise (arrays: the plan finds the grid).
         work.plan = planner(*array_sample(original, filtered), settings.parameters, mode=settings.mode,
-                            linear=settings.linear, blend_space=settings.blend_space)
+                            linear=settings.linear, blend_space=settings.blend_space,
+                            quantization=read_quantization(original_path) if original_path else None)
     plan = work.plan
     result.mode, result.blend_space, result.strength, result.reason = (plan.mode, plan.blend_space, plan.strength,
                                                                       plan.reason)

@@ -8,6 +8,9 @@ coefficients, so its error has two properties the safe default needs:
   up to 7 pixels from it, but no other block. The texture measure
   (:mod:`aarecovery.plan.texture`) reads grain only in blocks without an edge, where a
   drawing is flat and a photo keeps its texture;
+  A block of a drawing without an edge is therefore flat in luma (within the decoder's
+  rounding) however low the quality, while a photo's keeps its shading
+  (:func:`quiet_block_grain`);
 * it is **bounded by the quantization tables**: each coefficient is off by at most half its
   step, so a pixel's error has a standard deviation of about ``sqrt(mean(q^2) / 12)`` levels
   (:func:`noise_from_tables`). The pure colours of thin features ignore contrasts of that
@@ -25,12 +28,33 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CompressionEvidence", "NO_COMPRESSION", "BLOCK", "noise_from_tables", "detect_block_grid",
+__all__ = ["quiet_block_grain", "BLOCK_GRAIN_SHARE", "CompressionEvidence", "NO_COMPRESSION", "BLOCK", "noise_from_tables", "detect_block_grid",
            "compression_evidence", "GRID_MARGIN", "STANDARD_LUMA_TABLE",
-           "NOISE_CONTRAST_SIGMAS"]
+           "NOISE_CONTRAST_SIGMAS", "COMPRESSED_REPAIR_TO_ERROR"]
 
 #: Side of a JPEG block, in pixels of the luma plane.
 BLOCK = 8
+#: Share of O's edge-free blocks (on the grid) whose luma is not flat, above which a
+#: compressed O is a photo. Measured on the real-tools tuning half's analysis windows (PNG
+#: and JPEG q 75-98 alike): drawings 0.00-0.17 (serif 0.04-0.08, star burst 0.00-0.17),
+#: photos 0.93-1.00; but photos at their camera's resolution (crops of the bundled photos
+#: saved at q 75) 0.22-0.95: a uniform sky decodes flat. Hence the low bar, and at least 16
+#: edge-free blocks (the maps' 5-7 blocks read 0.20-0.43 from their soft fills).
+BLOCK_GRAIN_SHARE = 0.15
+# A block spanning less than this in luma (8-bit levels) is flat: a flat block decodes to one
+# value, and the colour conversion rounds it by a level or two.
+_BLOCK_GRAIN_RANGE = 2.5
+# A block spanning more than this holds an edge (and its ringing): it says nothing of grain.
+_BLOCK_EDGE_RANGE = 24.0
+# Fewer edge-free blocks than this leave the grain undecided (dense line art).
+_MIN_QUIET_BLOCKS = 16
+#: The repair-to-error ratio (``aarecovery.plan.model_error``) a neighbourhood filter on
+#: compressed hard-edged content needs before it is repaired at all: the model's error
+#: carried through the filter underestimates what ringing does there. Tuning half, JPEG
+#: drawings: G'MIC's bilateral on the star burst (q 85) ratio 5.9 lost 0.14 dB; unsharp masks
+#: 6.9 (star burst, +0.28 in error reduction) and 20 (serif, +0.20). Set above the loss with
+#: a margin, not swept: held out, every repaired case had a ratio over 100.
+COMPRESSED_REPAIR_TO_ERROR = 10.0
 #: Extremes closer than this many standard deviations of the compression noise are not a
 #: thin feature and its paper (``PureColourPrior.noise_contrast``). Measured on JPEG scans of
 #: text on tinted paper thresholded at 55 % (256 x 256 pages, 40 px margins), F's background
@@ -214,6 +238,37 @@ def _measured_table(coefficients):
             scales.append(fitting.max() / STANDARD_LUMA_TABLE[u, v])
     scale = float(np.median(scales)) if scales else _SMALLEST_SCALE
     return np.clip(np.rint(STANDARD_LUMA_TABLE * max(scale, _SMALLEST_SCALE)), 1, 255)
+
+
+def quiet_block_grain(encoded, evidence):
+    """Share of O's edge-free blocks that are not flat in luma: grain that compression kept.
+
+    JPEG noise stays inside the blocks that hold an edge, so away from them a decoded
+    drawing is flat; the pixel-wise grain (``aarecovery.plan.texture.grain``) reads the
+    ringing near edges as texture (JPEG drawings 0.15-0.98).
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (H, W, 3)
+        O's encoded colour (the analysis window).
+    evidence : CompressionEvidence
+        Its grid (``phase``).
+
+    Returns
+    -------
+    float or None
+        None when fewer than 16 blocks are free of edges.
+    """
+    luma = encoded[..., :3].astype(np.float64) @ np.array([0.299, 0.587, 0.114]) * 255.0
+    row, column = evidence.phase
+    rows, columns = (luma.shape[0] - row) // BLOCK, (luma.shape[1] - column) // BLOCK
+    blocks = luma[row:row + rows * BLOCK, column:column + columns * BLOCK]
+    blocks = blocks.reshape(rows, BLOCK, columns, BLOCK).transpose(0, 2, 1, 3).reshape(-1, BLOCK * BLOCK)
+    spans = blocks.max(axis=1) - blocks.min(axis=1) if len(blocks) else np.zeros(0)
+    quiet = spans[spans < _BLOCK_EDGE_RANGE]
+    if quiet.size < _MIN_QUIET_BLOCKS:
+        return None
+    return float((quiet > _BLOCK_GRAIN_RANGE).mean())
 
 
 def compression_evidence(encoded, tables=None):
