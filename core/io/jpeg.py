@@ -6,8 +6,6 @@ searches its pixels for the block grid instead. Pillow parses the tables with th
 without decoding the pixels.
 """
 
-from PIL import Image, UnidentifiedImageError
-
 __all__ = ["read_quantization"]
 
 
@@ -25,12 +23,15 @@ def read_quantization(path):
         depend on the order of the steps), or None when the file is not a JPEG (a PNG, a TIFF: no compression noise)
         or cannot be opened as an image (``read_image`` reports that).
     """
+    # Pillow is imported here, as in ``read.py``: the GIMP plug-in's bundle has no Pillow.
+    from PIL import Image, UnidentifiedImageError
     try:
         with Image.open(path) as image:
             if image.format != "JPEG":
                 return None
             tables = getattr(image, "quantization", None)
-    except (OSError, UnidentifiedImageError, ValueError):
+    except (OSError, UnidentifiedImageError, ValueError, Image.DecompressionBombError):
+        # read_image reports these with its own limit; the tables are only evidence.
         return None
     if not tables:
         return None
