@@ -8,6 +8,9 @@ without decoding the pixels.
 
 __all__ = ["read_quantization"]
 
+# Every JPEG file starts with a start-of-image marker followed by another marker.
+_JPEG_SIGNATURE = b"\xff\xd8\xff"
+
 
 def read_quantization(path):
     """The quantization tables of a JPEG file, or None for any other file.
@@ -20,10 +23,17 @@ def read_quantization(path):
     -------
     list of list of int or None
         64 steps per table, luma first, as Pillow gives them (the noise bound does not
-        depend on the order of the steps), or None when the file is not a JPEG (a PNG, a TIFF: no compression noise)
-        or cannot be opened as an image (``read_image`` reports that).
+        depend on the order of the steps); None when the file is not a JPEG (a PNG, a TIFF:
+        no compression noise) or cannot be opened as an image (``read_image`` reports that).
     """
-    # Pillow is imported here, as in ``read.py``: the GIMP plug-in's bundle has no Pillow.
+    try:
+        with open(path, "rb") as handle:
+            if handle.read(len(_JPEG_SIGNATURE)) != _JPEG_SIGNATURE:
+                return None
+    except OSError:
+        return None
+    # Pillow only for a JPEG, as in ``read.py``: the GIMP plug-in's bundle has no Pillow, and
+    # an .npy pair read under a tight memory limit should not pay for importing it.
     from PIL import Image, UnidentifiedImageError
     try:
         with Image.open(path) as image:
