@@ -20,7 +20,7 @@ from .backends import GLUnavailable
 from .batch import recover_many
 from .engine import Engine
 from .errors import InputError, OrderWarning, OrientationWarning
-from .io import read_image, write_image
+from .io import read_image, read_quantization, write_image
 from .outcome import RecoverySummary, summarize_recovery
 from .params import BACKENDS, BLEND_SPACES, GL_PATHS, MODES, PARAMETERS
 from .pipeline import recover
@@ -28,4 +28,5 @@ from .plan.order import check_order
 
 __all__ = ["recover", "recover_many", "check_order", "summarize_recovery", "Engine", "Plan", "Decision", "RecoveryMaps",
            "RecoverySummary", "InputError", "GLUnavailable", "OrderWarning", "OrientationWarning", "read_image",
+           "read_quantization",
            "write_image", "filters", "PARAMETERS", "BACKENDS", "GL_PATHS", "MODES", "BLEND_SPACES", "__version__"]

@@ -85,6 +85,7 @@ class Engine:
         self._pair = None
         self._loaded_space = None
         self._analysis = None
+        self._quantization = None
         self.last_seconds = None
         #: Plan or None: what the last :meth:`compute` or :meth:`run` did (mode, blend space,
         #: strength, and why), or what :func:`aarecovery.recover` decided with this engine
@@ -117,7 +118,7 @@ class Engine:
         return None if self._layout is None else (self._layout.width, self._layout.height)
 
     @_exclusive
-    def set_images(self, original, filtered, *, linear=False, blend_space=None):
+    def set_images(self, original, filtered, *, linear=False, blend_space=None, quantization=None):
         """Check and load an image pair (uploads it once for GL).
 
         Parameters
@@ -131,6 +132,10 @@ class Engine:
             Where the blend model is fitted and imposed. By default ``mode="safe"`` picks it
             per image and ``mode="paper"`` uses ``"linear"``, the paper's choice and right for
             optical (camera) antialiasing.
+        quantization : sequence of sequence of int, optional
+            The quantization tables of O's JPEG file (``aarecovery.read_quantization``), for
+            the safe default's compression evidence; without them it looks for a JPEG block
+            grid in O's pixels.
 
         Raises
         ------
@@ -149,6 +154,7 @@ class Engine:
         self._layout = f_layout
         self._pair = (original, o_layout, filtered, f_layout, bool(linear), blend_space)
         self._analysis = None
+        self._quantization = quantization
         self._load(blend_space or "linear")
 
     def _load(self, space):
@@ -194,7 +200,7 @@ class Engine:
         original, _, filtered, _, linear, blend_space = self._pair
         parameters = Parameters(sigma_d, sigma_e, iterations, strength)
         if mode == "safe" and self._analysis is None:
-            self._analysis = analyse_pair(*array_sample(original, filtered), linear)
+            self._analysis = analyse_pair(*array_sample(original, filtered), linear, self._quantization)
         return make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space,
                          analysis=self._analysis)
 

@@ -26,7 +26,7 @@ __all__ = ["recover", "recover_tiles", "tile_side"]
 
 def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
             backend="auto", linear=False, blend_space=None, return_maps=False, tile_size=None, engine=None,
-            mode=DEFAULT_MODE, gl_path="auto", strength=STRENGTH.default, plan=None):
+            mode=DEFAULT_MODE, gl_path="auto", strength=STRENGTH.default, plan=None, quantization=None):
     """Repair the antialiased edges of `filtered` using the edges of `original`.
 
     Parameters
@@ -76,6 +76,10 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
         window ``aarecovery.sample`` picks, as this function would make it): the batch
         makes it in a worker process. It then decides instead of the parameters, `mode`,
         `strength` and `blend_space`.
+    quantization : sequence of sequence of int, optional
+        The quantization tables of `original`'s JPEG file (:func:`aarecovery.read_quantization`):
+        the safe default then knows how large O's compression noise is. Without them it looks
+        for a JPEG block grid in O's pixels.
 
     Returns
     -------
@@ -125,7 +129,7 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     try:
         if plan is None:
             plan = make_plan(*array_sample(original, filtered), parameters, mode=mode, linear=linear,
-                             blend_space=blend_space)
+                             blend_space=blend_space, quantization=quantization)
         if plan.keeps_filtered and not return_maps:
             if engine is not None:
                 engine.last_plan = plan

@@ -40,6 +40,23 @@ def _channel_mixer():
     return original, linear_to_srgb(np.clip(mixed, 0, 1))
 
 
+def _jpeg_page_thresholded(quality=85):
+    """A page of serif text saved as a JPEG and decoded, then thresholded: a scan's workflow."""
+    import io
+
+    from PIL import Image
+
+    page = np.rint(_drawing("serif", 96) * 255).astype(np.uint8)
+    buffer = io.BytesIO()
+    Image.fromarray(page).save(buffer, format="JPEG", quality=quality)
+    buffer.seek(0)
+    with Image.open(buffer) as decoded:
+        original = np.asarray(decoded.convert("RGB")).astype(np.float32) / 255
+    luma = original @ np.array([0.2126, 0.7152, 0.0722], np.float32)
+    filtered = np.repeat((luma > 0.5)[..., None], 3, axis=-1).astype(np.float32)
+    return original, filtered
+
+
 def _quantised_photo():
     original = _photo_like(seed=2)
     return original, _quantise(original, PALETTE)
@@ -48,6 +65,7 @@ def _quantised_photo():
 PAIRS = {
     Decision.LOWPASS_KEPT: lambda: _case("shapes", "blur"),
     Decision.AFFINE_KEPT: _channel_mixer,
+    Decision.POINTWISE_HARD_EDGED_COMPRESSED: _jpeg_page_thresholded,
     Decision.POINTWISE_HARD_EDGED: lambda: _case("shapes", "posterize"),
     Decision.POINTWISE_CALIBRATED: lambda: _case("astronaut", "posterize"),
     Decision.NEIGHBOURHOOD_TEXTURED_KEPT: lambda: _case("astronaut", "unsharp"),

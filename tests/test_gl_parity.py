@@ -185,6 +185,17 @@ def test_pure_colour_jacobi_steps_agree_on_float_data(gl_engine, iterations):
     assert np.abs(expected - paper).max() > 16 / 255
 
 
+def test_pure_colours_agree_above_a_jpegs_noise(gl_engine):
+    # O's compression noise raises the contrast an extreme needs (a uniform in GL).
+    from jpeg_scans import scan_page, threshold
+    _, original, _ = scan_page(7, 75)
+    filtered = threshold(original)
+    actual = aarecovery.recover(original, filtered, engine=gl_engine)
+    assert gl_engine.last_plan.pure_colours.noise_contrast > 30 / 255
+    expected = aarecovery.recover(original, filtered, backend="numpy")
+    assert np.abs(actual.astype(np.int64) - expected).max() <= 1
+
+
 def _sparse_pair():
     """A few features in a large flat image: most blocks are skipped."""
     from aarecovery.lab.groundtruth import make_case

@@ -31,6 +31,10 @@ class Decision(str, enum.Enum):
     POINTWISE_HARD_EDGED = "pointwise-hard-edged"
     """A point-wise filter on hard-edged content: full strength (and pure colours of thin
     features when the table allows)."""
+    POINTWISE_HARD_EDGED_COMPRESSED = "pointwise-hard-edged-compressed"
+    """A point-wise filter on hard-edged content whose O was JPEG-compressed: the strength
+    self-calibration finds (the compression noise goes through the filter too), and pure
+    colours of thin features only between extremes farther apart than that noise."""
     POINTWISE_CALIBRATED = "pointwise-calibrated"
     """A point-wise filter on a textured image: the strength self-calibration finds, in the
     regions that read as textured; full strength in those that read as hard-edged (text or

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, fields
 from .. import stream
 from ..contract import check_same_size, check_values, layout_of
 from ..errors import InputError
-from ..io import check_output_path, os_error_line, read_image, warn_if_orientations_differ, write_image, write_images
+from ..io import check_output_path, os_error_line, read_image, read_quantization, warn_if_orientations_differ, write_image, write_images
 from ..io.formats import lossless_extension
 from ..io.maps import map_paths, maps_as_images
 from ..params import Parameters
@@ -343,8 +343,10 @@ def _prepare(work, settings, capabilities, started, planner):
         if work.output is not None:
             check_output_path(work.target, f_layout.shape)
         work.original, work.filtered = original, filtered
+        # A JPEG original's tables bound its compression noise (arrays: the plan finds the grid).
         work.plan = planner(*array_sample(original, filtered), settings.parameters, mode=settings.mode,
-                            linear=settings.linear, blend_space=settings.blend_space)
+                            linear=settings.linear, blend_space=settings.blend_space,
+                            quantization=read_quantization(original_path) if original_path else None)
     if original_path and filtered_path:
         warn_if_orientations_differ(original_path, filtered_path, job.name)
     plan = work.plan

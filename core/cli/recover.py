@@ -5,6 +5,7 @@ import os
 
 # Already imported with the package; the codecs and the engine's backends load in run().
 from ..errors import InputError
+from ..io.jpeg import read_quantization
 from ..io.maps import MAP_SCALES, map_paths, maps_as_images
 from ..params import BACKENDS, BLEND_SPACES, GL_PATHS, PARAMETERS
 from ..tiling import DEFAULT_TILES, SENSIBLE_TILE
@@ -195,7 +196,8 @@ def _recover_files(args, params, pool):
         result = recover(original, filtered, sigma_d=params.sigma_d, sigma_e=params.sigma_e,
                          iterations=params.iterations, linear=args.linear, blend_space=args.blend_space,
                          return_maps=args.maps is not None, tile_size=args.tile_size, engine=engine,
-                         mode="paper" if args.paper else "safe", strength=params.strength)
+                         mode="paper" if args.paper else "safe", strength=params.strength,
+                         quantization=read_quantization(args.original))
         seconds = time.perf_counter() - start
         backend = engine.backend
         plan = engine.last_plan

@@ -5,6 +5,7 @@ writes atomically in what the extension's format holds.
 """
 
 from .formats import WRITE_FORMATS
+from .jpeg import read_quantization
 from .limits import DEFAULT_MAX_BYTES, check_decoded_size
 from .parts import remove_stale_parts
 from .read import declared_image, describe_orientations, orientation_tag, read_image, warn_if_orientations_differ
@@ -12,4 +13,5 @@ from .write import DiskError, check_output_path, check_writable_folder, os_error
 
 __all__ = ["read_image", "write_image", "write_images", "check_output_path", "check_writable_folder", "os_error_line",
            "remove_stale_parts", "DiskError", "WRITE_FORMATS", "DEFAULT_MAX_BYTES", "check_decoded_size",
-           "orientation_tag", "describe_orientations", "warn_if_orientations_differ", "declared_image"]
+           "orientation_tag", "describe_orientations", "warn_if_orientations_differ", "declared_image",
+           "read_quantization"]

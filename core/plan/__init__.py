@@ -14,7 +14,8 @@ from .analysis import PairAnalysis, analyse, analyse_pair
 __all__ = ["make_plan", "Decision", "Plan", "PairAnalysis", "analyse", "analyse_pair"]
 
 
-def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blend_space=None, analysis=None):
+def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blend_space=None, analysis=None,
+              quantization=None):
     """Resolve the mode for one pair into a :class:`Plan`.
 
     Parameters
@@ -32,6 +33,9 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
     analysis : PairAnalysis, optional
         The pair's analysis when it is already known (an engine keeps it per pair, so that a
         slider change does not analyse again).
+    quantization : sequence of sequence of int, optional
+        The quantization tables of O's JPEG file (``aarecovery.io.read_quantization``);
+        without them the analysis looks for a block grid in O's pixels.
 
     Returns
     -------
@@ -48,7 +52,7 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
                     reason="the published method (Yang et al. 2011), without the safe default's analysis"
                            + ("" if asked is None else f"; strength {asked:g} as asked"), decision=Decision.PAPER)
     if analysis is None:
-        analysis = analyse_pair(original, filtered, linear)
+        analysis = analyse_pair(original, filtered, linear, quantization)
     # A strength the user gives overrides the analysis's, and its local plan, and forces a
     # repair where it keeps F; the other decisions (blend space, pure colours) stand.
     return Plan(**common, blend_space=blend_space or analysis.blend_space,

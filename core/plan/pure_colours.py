@@ -171,7 +171,7 @@ def affine_in_key_miss(original, filtered, edges, key):
     return float(miss.max(axis=1).mean())
 
 
-def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None):
+def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None, noise_contrast=0.0):
     """The prior for the passes, from the first fitted table fit for the extension.
 
     Keys often tie (a threshold of black/white text matches per channel and by luma); the
@@ -189,6 +189,9 @@ def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None
         F's encoded colour, with `edges` (bool, shape (H, W)): where F is an affine function
         of the table's key there, thin features keep to O's flat colours and are not
         extended to the colour cube.
+    noise_contrast : float, optional
+        O's compression noise as a contrast (``aarecovery.plan.compression``): extremes
+        closer than that are not thin features.
 
     Returns
     -------
@@ -201,7 +204,8 @@ def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None
            and is_monotone(candidate.table)]
     if not fit:
         return None
-    priors = [PureColourPrior(candidate.key, palette=palette, **_extrapolated(original, candidate)) for candidate in fit
+    priors = [PureColourPrior(candidate.key, palette=palette, noise_contrast=float(noise_contrast),
+                              **_extrapolated(original, candidate)) for candidate in fit
               if candidate.consistency >= fit[0].consistency and candidate.mean_miss <= fit[0].mean_miss + _TIE_MISS]
     chosen = priors[0]
     if not _agree_where_extended(priors, original, blend_space):

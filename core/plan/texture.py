@@ -20,11 +20,16 @@ Two measures, each where it works:
   high-pass alone called the serif page's flat paper 0.06 grainy.
 
 Content is hard-edged when both say so (the colour test only where O has colour).
+
+Where O is a JPEG (``aarecovery.plan.compression``), the grain is read in the edge-free
+blocks of its grid instead (``quiet_block_grain``): compression noise stays in the blocks
+that hold an edge, so that a JPEG drawing is flat there and a photo is not.
 """
 
 import numpy as np
 
 from ..spec.sobel import gradient_magnitude
+from .compression import BLOCK_GRAIN_SHARE, quiet_block_grain
 
 __all__ = ["grain", "is_textured", "STRICT_RESIDUAL", "GRAIN_SHARE"]
 
@@ -83,7 +88,7 @@ def grain(encoded):
     return float(grainy[quiet].mean())
 
 
-def is_textured(encoded, colour_line_residual):
+def is_textured(encoded, colour_line_residual, compression=None):
     """Whether O is a photo by either measure.
 
     Parameters
@@ -91,6 +96,9 @@ def is_textured(encoded, colour_line_residual):
     encoded : ndarray of float32, shape (H, W, 3)
     colour_line_residual : float or None
         ``blend_space.colour_line_residual`` in the chosen space (None: too few edges).
+    compression : CompressionEvidence, optional
+        O's compression (``aarecovery.plan.compression``); None or uncompressed: the pixels'
+        grain decides.
 
     Returns
     -------
@@ -98,6 +106,10 @@ def is_textured(encoded, colour_line_residual):
     why : str
         The measure that decided, for the plan's reason.
     """
+    if compression is not None and compression.compressed:
+        blocks = quiet_block_grain(encoded, compression)
+        if blocks is not None:
+            return blocks > BLOCK_GRAIN_SHARE, f"grain in {blocks:.2f} of the JPEG's edge-free blocks"
     measured = grain(encoded)
     if measured is not None:
         return measured > GRAIN_SHARE, f"grain {measured:.2f} away from edges"

@@ -153,6 +153,10 @@ class PureColourPrior:
         for a fitted point-wise table. False for a neighbourhood filter that keeps flat
         colours (``aarecovery.plan.flat_colours``): its table is what it does to a flat
         area, and F at a thin feature differs from that by the very damage to repair.
+    noise_contrast : float
+        Extremes closer than this in every encoded channel are not tested, where it exceeds
+        :data:`MIN_CONTRAST`: the compression noise O carries (``aarecovery.plan.compression``),
+        whose ringing next to a letter is not a thin stroke. 0: O is not compressed.
     """
 
     key: str
@@ -162,6 +166,12 @@ class PureColourPrior:
     key_high: np.ndarray = None
     to_cube: bool = True
     explain_filtered: bool = True
+    noise_contrast: float = 0.0
+
+    @property
+    def min_contrast(self):
+        """float: the contrast below which two extremes are not a thin feature on its paper."""
+        return max(MIN_CONTRAST, float(self.noise_contrast))
 
     def key_range(self):
         """Observed key range (bin centres of the first and last filled bins), each shape (3,)."""
@@ -315,7 +325,7 @@ def extend_extreme(far, near, around, filtered_far, on_border, palette, prior, b
     span = far - near
     length = np.sqrt(dot(span, span))
     steps = np.abs(_encoded_of(far, blend_space) - _encoded_of(near, blend_space)).max(axis=0)
-    defined = (length > np.float32(1e-6)) & (np.maximum(steps, np.abs(span[3])) >= np.float32(MIN_CONTRAST))
+    defined = (length > np.float32(1e-6)) & (np.maximum(steps, np.abs(span[3])) >= np.float32(prior.min_contrast))
     direction = span / np.where(defined, length, np.float32(1))
     t_far = dot(far - near, direction)
     limit = t_far - np.float32(RIDGE_MARGIN) * length

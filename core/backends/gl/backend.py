@@ -419,7 +419,8 @@ class GLBackend:
         palette[:len(colours)] = colours
         low, high = prior.key_range()
         return dict(palette_size=len(colours), palette=[tuple(map(float, colour)) for colour in palette],
-                    key_low=tuple(map(float, low)), key_high=tuple(map(float, high)))
+                    key_low=tuple(map(float, low)), key_high=tuple(map(float, high)),
+                    noise_contrast=float(prior.noise_contrast))
 
     def _fit_blend_model(self, sources, uniforms, defines, lists, maps):
         """The model and the first Jacobi iterate (and the edge map, the Jacobi steps' constant with pure colours)."""

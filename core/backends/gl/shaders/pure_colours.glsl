@@ -7,6 +7,7 @@ uniform vec3 palette[32];          // O's flat colours, opaque, in the working s
 uniform int palette_size;
 uniform vec3 key_low;              // O's key range (bin centres of the table's first and last
 uniform vec3 key_high;             // filled bins, per column); beyond it the table is extrapolated
+uniform float noise_contrast;      // O's compression noise as a contrast (0: not compressed)
 
 // The prior's switches are compile-time defines, not uniforms: llvmpipe runs both sides of
 // every branch under a mask, so a uniform switch paid for every key's sRGB conversions
@@ -150,11 +151,11 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
     vec4 span = far - near;
     float len = sqrt(dot(span, span));
     if (!(len > 1e-6)) return result;
-    // Extremes within an 8-bit gradient's noise of each other are not a thin feature.
+    // Extremes within an 8-bit gradient's (or a JPEG's) noise of each other are not a thin feature.
     vec3 far_encoded = encoded_of(far);
     vec3 near_encoded = encoded_of(near);
     vec3 steps = abs(far_encoded - near_encoded);
-    if (!(max(max(max(steps.r, steps.g), steps.b), abs(span.a)) >= MIN_CONTRAST)) return result;
+    if (!(max(max(max(steps.r, steps.g), steps.b), abs(span.a)) >= max(MIN_CONTRAST, noise_contrast))) return result;
     if (q.x <= 0 || q.y <= 0 || q.x >= size.x - 1 || q.y >= size.y - 1) return result;
     float tolerance_sq = PALETTE_TOLERANCE * PALETTE_TOLERANCE;
     // One loop over the palette for both extremes (a loop costs its full length on llvmpipe,

@@ -1,0 +1,302 @@
+"""Compression evidence: is O a decoded JPEG, where is its 8 x 8 block grid, how large is its noise?
+
+A JPEG stores each 8 x 8 block (16 x 16 for chroma subsampled 4:2:0) as quantized DCT
+coefficients, so its error has two properties the safe default needs:
+
+* it stays **inside the block**: a block of one flat colour decodes flat (its only
+  coefficient is the mean), and the ringing of an edge fills the block that holds the edge,
+  up to 7 pixels from it, but no other block. The texture measure
+  (:mod:`aarecovery.plan.texture`) reads grain only in blocks without an edge, where a
+  drawing is flat and a photo keeps its texture;
+  A block of a drawing without an edge is therefore flat in luma (within the decoder's
+  rounding) however low the quality, while a photo's keeps its shading
+  (:func:`quiet_block_grain`);
+* it is **bounded by the quantization tables**: each coefficient is off by at most half its
+  step, so a pixel's error has a standard deviation of about ``sqrt(mean(q^2) / 12)`` levels
+  (:func:`noise_from_tables`). The pure colours of thin features ignore contrasts of that
+  size (:mod:`aarecovery.plan.pure_colours`): a ringing pixel on the paper next to a letter
+  is not a thin stroke to restore.
+
+The evidence comes from the file where there is one (``aarecovery.io.jpeg`` reads the tables
+of a JPEG, and only of a JPEG), else from the pixels: on the block grid, a JPEG's high frequencies are quantized to zero
+(:func:`detect_block_grid`), and the steps of its low frequencies give the table's scale.
+The grid's phase is always measured on the pixels, since the analysis reads a window that
+need not start on the grid.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["quiet_block_grain", "BLOCK_GRAIN_SHARE", "CompressionEvidence", "NO_COMPRESSION", "BLOCK", "noise_from_tables", "detect_block_grid",
+           "compression_evidence", "GRID_MARGIN", "STANDARD_LUMA_TABLE",
+           "NOISE_CONTRAST_SIGMAS", "MIN_NOISE_CONTRAST",
+           "COMPRESSED_REPAIR_TO_ERROR"]
+
+#: Side of a JPEG block, in pixels of the luma plane.
+BLOCK = 8
+#: Share of O's edge-free blocks (on the grid) whose luma is not flat, above which a
+#: compressed O is a photo. Measured on the real-tools tuning half's analysis windows (PNG
+#: and JPEG q 75-98 alike): drawings 0.00-0.17 (serif 0.04-0.08, star burst 0.00-0.17),
+#: photos 0.93-1.00; but photos at their camera's resolution (crops of the bundled photos
+#: saved at q 75) 0.22-0.95: a uniform sky decodes flat. Hence the low bar, and at least 16
+#: edge-free blocks (the maps' 5-7 blocks read 0.20-0.43 from their soft fills).
+BLOCK_GRAIN_SHARE = 0.15
+# A block spanning less than this in luma (8-bit levels) is flat: a flat block decodes to one
+# value, and the colour conversion rounds it by a level or two.
+_BLOCK_GRAIN_RANGE = 2.5
+# A block spanning more than this holds an edge (and its ringing): it says nothing of grain.
+_BLOCK_EDGE_RANGE = 24.0
+# Fewer edge-free blocks than this leave the grain undecided (dense line art).
+_MIN_QUIET_BLOCKS = 16
+#: The repair-to-error ratio (``aarecovery.plan.model_error``) a neighbourhood filter on
+#: compressed hard-edged content needs before it is repaired at all: the model's error
+#: carried through the filter underestimates what ringing does there. Tuning half, JPEG
+#: drawings: G'MIC's bilateral on the star burst (q 85) ratio 5.9 lost 0.14 dB; unsharp masks
+#: 6.9 (star burst, +0.28 in error reduction) and 20 (serif, +0.20). Set above the loss with
+#: a margin, not swept: held out, every repaired case had a ratio over 100.
+COMPRESSED_REPAIR_TO_ERROR = 10.0
+#: Extremes closer than this many standard deviations of the compression noise are not a
+#: thin feature and its paper (``PureColourPrior.noise_contrast``). Measured on JPEG scans of
+#: text on tinted paper thresholded at 55 % (256 x 256 pages, 40 px margins), F's background
+#: pixels (5 x 5 all white) made darker by more than 10 levels: with the contrast's floor of
+#: 8.5 levels alone, 4 pages each at q 75 / 85 / 95: 9550 / 7686 / 234; 5 deviations (49 /
+#: 29 / 9.7 levels) 5 / 71 / 207; on the two worst pages at q 85 / 95, 5 deviations 71 / 207,
+#: 7 deviations 0 / 2, 9: 0 / 0. The real-tools quick tuning half did not move at 5.
+NOISE_CONTRAST_SIGMAS = 7.0
+#: The least contrast a compressed O's extremes need: ringing next to a letter does not shrink
+#: with the noise's deviation as fast as the tables do. At q 95 (1.9 levels, 7 deviations
+#: 13.6 levels) 3 of 8 pages (192 x 192, tinted and textured paper) kept 1-12 darkened
+#: bare-paper pixels; at 20 levels none (nor at 10 deviations).
+MIN_NOISE_CONTRAST = 20.0 / 255
+#: The share of zero high-frequency coefficients at the best grid phase over that at the
+#: second best, above which the pixels show a block grid (see :func:`detect_block_grid`).
+#: Measured on the real-tools quick suite's analysis windows: PNG originals 0.000-0.055
+#: (the star burst's symmetric spokes), JPEG q 85 0.15-0.39, q 95 0.10-0.32 but the star
+#: burst's 0.036 (undetected: at q 95 its noise is below a level).
+GRID_MARGIN = 0.08
+# A block takes part when some AC coefficient exceeds this (8-bit levels, orthonormal DCT):
+# flat blocks are all zeros at every phase and say nothing.
+_BUSY_COEFFICIENT = 8.0
+# A coefficient counts as zero within this (the decoder's rounding to 8 bits and the colour
+# conversion leave about 0.3).
+_ZERO_COEFFICIENT = 0.75
+# Fewer busy blocks than this leave the grid undecided.
+_MIN_BUSY_BLOCKS = 8
+# Frequencies whose quantization step the grid path estimates, and the steps it tries.
+_PROBED = ((0, 1), (1, 0), (1, 1), (0, 2), (2, 0))
+_STEPS = np.arange(1, 64)
+_LATTICE_SCORE = 0.6
+# Steps of 1-2 levels (quality 95 and up) fit every lattice within the decoder's rounding and
+# cannot be measured: a grid without a measured step gets quality 95's table (libjpeg's scale
+# 0.1), the smallest noise the grid test detects.
+_SMALLEST_SCALE = 0.1
+#: The luma quantization table of the JPEG standard (ITU-T T.81, Annex K), which libjpeg
+#: scales by the quality setting: the grid path scales it to the steps it measures.
+STANDARD_LUMA_TABLE = np.array([
+    16, 11, 10, 16, 24, 40, 51, 61, 12, 12, 14, 19, 26, 58, 60, 55,
+    14, 13, 16, 24, 40, 57, 69, 56, 14, 17, 22, 29, 51, 87, 80, 62,
+    18, 22, 37, 56, 68, 109, 103, 77, 24, 35, 55, 64, 81, 104, 113, 92,
+    49, 64, 78, 87, 103, 121, 120, 101, 72, 92, 95, 98, 112, 100, 103, 99], np.float64).reshape(BLOCK, BLOCK)
+_INDEX = np.arange(BLOCK)
+_DCT = np.sqrt(2.0 / BLOCK) * np.cos(np.pi * (2 * _INDEX[None, :] + 1) * _INDEX[:, None] / (2 * BLOCK))
+_DCT[0] /= np.sqrt(2.0)
+
+
+@dataclass(frozen=True)
+class CompressionEvidence:
+    """What O's pixels or file say about block compression.
+
+    Attributes
+    ----------
+    source : {"none", "quantization tables", "block grid"}
+        Where the evidence came from; "none": O shows no compression.
+    noise : float
+        Standard deviation of the compression error per pixel, encoded values in [0, 1];
+        0 without compression.
+    phase : tuple of int
+        ``(row, column)`` of the first block's top-left corner in the analysed window.
+    margin : float
+        How clearly the grid stands out (:func:`detect_block_grid`; 0 without one).
+    """
+
+    source: str = "none"
+    noise: float = 0.0
+    phase: tuple = (0, 0)
+    margin: float = 0.0
+
+    @property
+    def compressed(self):
+        """bool: O carries block-compression noise."""
+        return self.source != "none"
+
+    @property
+    def contrast(self):
+        """float: the contrast two extremes need to be told from this noise (encoded); 0 uncompressed."""
+        if not self.compressed:
+            return 0.0
+        return max(NOISE_CONTRAST_SIGMAS * self.noise, MIN_NOISE_CONTRAST)
+
+    def describe(self):
+        """A few words for the plan's reason."""
+        if not self.compressed:
+            return "no compression"
+        return f"JPEG ({self.source}, noise {self.noise * 255:.1f} levels)"
+
+
+#: O as a lossless file or an array without a block grid.
+NO_COMPRESSION = CompressionEvidence()
+
+
+def noise_from_tables(tables):
+    """The per-pixel standard deviation of the error the quantization tables allow.
+
+    Each coefficient's rounding error is uniform within its step ``q`` (variance
+    ``q^2 / 12``); the 8 x 8 DCT is orthonormal, so a pixel's error variance is the mean of
+    those over the 64 coefficients. The luma table (the first) decides: threshold and
+    levels key on luma, and chroma error is blurred by the subsampling. It is a bound: where
+    a coefficient is smaller than half its step the error is the coefficient itself.
+
+    Parameters
+    ----------
+    tables : sequence of sequence of int
+        Quantization tables, 64 steps each, luma first (8-bit levels).
+
+    Returns
+    -------
+    float
+        Encoded values in [0, 1].
+    """
+    luma = np.asarray(tables[0], np.float64).reshape(-1)
+    if luma.size != BLOCK * BLOCK:
+        raise ValueError(f"a quantization table has 64 steps, got {luma.size}")
+    return float(np.sqrt(np.mean(luma * luma) / 12.0) / 255.0)
+
+
+def _block_dct(luma, row, column):
+    """Orthonormal 8 x 8 DCTs of the blocks of a grid at a phase, shape (N, 8, 8)."""
+    rows, columns = (luma.shape[0] - row) // BLOCK, (luma.shape[1] - column) // BLOCK
+    blocks = luma[row:row + rows * BLOCK, column:column + columns * BLOCK]
+    blocks = blocks.reshape(rows, BLOCK, columns, BLOCK).transpose(0, 2, 1, 3).reshape(-1, BLOCK, BLOCK)
+    return _DCT @ blocks @ _DCT.T
+
+
+def _busy(coefficients):
+    return np.abs(coefficients.reshape(len(coefficients), -1)[:, 1:]).max(axis=1) > _BUSY_COEFFICIENT
+
+
+def detect_block_grid(encoded):
+    """Find an 8 x 8 block grid in O's pixels, and the quantization that made it.
+
+    On the grid, a JPEG's busy blocks (those with some detail) have most high-frequency
+    coefficients exactly zero: quantization removed them. Shifted off the grid, the blocks
+    straddle the old boundaries and those coefficients are not zero; a lossless image has no
+    phase where they vanish more than at its neighbours.
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (H, W, 3)
+        O's encoded colour (the analysis window).
+
+    Returns
+    -------
+    phase : tuple of int
+        ``(row, column)`` offset of the grid in the window.
+    margin : float
+        Share of zero high-frequency coefficients at the best phase minus that at the second
+        best (0 when undecided).
+    table : ndarray of float64, shape (8, 8) or None
+        The standard luma table scaled to the steps measured at low frequencies on the grid
+        (None when undecided).
+    """
+    luma = encoded[..., :3].astype(np.float64) @ np.array([0.299, 0.587, 0.114]) * 255.0
+    if min(luma.shape) < 2 * BLOCK:
+        return (0, 0), 0.0, None
+    shares = np.full((BLOCK, BLOCK), -1.0)
+    for row in range(BLOCK):
+        for column in range(BLOCK):
+            coefficients = _block_dct(luma, row, column)
+            busy = _busy(coefficients)
+            if busy.sum() >= _MIN_BUSY_BLOCKS:
+                shares[row, column] = float((np.abs(coefficients[busy][:, 3:, 3:]) < _ZERO_COEFFICIENT).mean())
+    order = np.argsort(shares.ravel())
+    if shares.ravel()[order[-1]] < 0:
+        return (0, 0), 0.0, None
+    phase = tuple(int(i) for i in np.unravel_index(order[-1], shares.shape))
+    margin = float(shares.ravel()[order[-1]] - max(shares.ravel()[order[-2]], 0.0))
+    return phase, margin, _measured_table(_block_dct(luma, *phase))
+
+
+def _measured_table(coefficients):
+    """The standard table scaled to the quantization steps of a few low frequencies.
+
+    A coefficient quantized with step q is a multiple of q (within the decoder's rounding):
+    the largest step whose lattice the nonzero coefficients fit is the step.
+    """
+    coefficients = coefficients[_busy(coefficients)]
+    scales = []
+    for u, v in _PROBED:
+        values = coefficients[:, u, v]
+        values = values[np.abs(values) > 1.5]
+        if values.size < _MIN_BUSY_BLOCKS:
+            continue
+        scores = np.cos(2 * np.pi * values[None, :] / _STEPS[:, None]).mean(axis=1)
+        fitting = _STEPS[scores > _LATTICE_SCORE]
+        if fitting.size:
+            scales.append(fitting.max() / STANDARD_LUMA_TABLE[u, v])
+    scale = float(np.median(scales)) if scales else _SMALLEST_SCALE
+    return np.clip(np.rint(STANDARD_LUMA_TABLE * max(scale, _SMALLEST_SCALE)), 1, 255)
+
+
+def quiet_block_grain(encoded, evidence):
+    """Share of O's edge-free blocks that are not flat in luma: grain that compression kept.
+
+    JPEG noise stays inside the blocks that hold an edge, so away from them a decoded
+    drawing is flat; the pixel-wise grain (``aarecovery.plan.texture.grain``) reads the
+    ringing near edges as texture (JPEG drawings 0.15-0.98).
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (H, W, 3)
+        O's encoded colour (the analysis window).
+    evidence : CompressionEvidence
+        Its grid (``phase``).
+
+    Returns
+    -------
+    float or None
+        None when fewer than 16 blocks are free of edges.
+    """
+    luma = encoded[..., :3].astype(np.float64) @ np.array([0.299, 0.587, 0.114]) * 255.0
+    row, column = evidence.phase
+    rows, columns = (luma.shape[0] - row) // BLOCK, (luma.shape[1] - column) // BLOCK
+    blocks = luma[row:row + rows * BLOCK, column:column + columns * BLOCK]
+    blocks = blocks.reshape(rows, BLOCK, columns, BLOCK).transpose(0, 2, 1, 3).reshape(-1, BLOCK * BLOCK)
+    spans = blocks.max(axis=1) - blocks.min(axis=1) if len(blocks) else np.zeros(0)
+    quiet = spans[spans < _BLOCK_EDGE_RANGE]
+    if quiet.size < _MIN_QUIET_BLOCKS:
+        return None
+    return float((quiet > _BLOCK_GRAIN_RANGE).mean())
+
+
+def compression_evidence(encoded, tables=None):
+    """The compression evidence for O's analysis window.
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (H, W, 3)
+        O's encoded colour (the analysis window).
+    tables : sequence of sequence of int, optional
+        The quantization tables of O's JPEG file (``aarecovery.io.jpeg``); None for an
+        array or a lossless file, whose pixels are searched for a block grid.
+
+    Returns
+    -------
+    CompressionEvidence
+    """
+    phase, margin, measured = detect_block_grid(encoded)
+    if tables is not None:
+        return CompressionEvidence("quantization tables", noise_from_tables(tables), phase, margin)
+    if margin < GRID_MARGIN:
+        return CompressionEvidence(margin=margin)
+    return CompressionEvidence("block grid", noise_from_tables([measured]), phase, margin)

@@ -1,0 +1,161 @@
+"""JPEG-aware evidence: O's compression noise from its file or its pixels, kept out of F's flat areas."""
+
+import io
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import aarecovery
+from aarecovery.cli import main
+from aarecovery.plan.compression import (NO_COMPRESSION, NOISE_CONTRAST_SIGMAS, compression_evidence,
+                                         detect_block_grid, noise_from_tables)
+from jpeg_scans import haze, scan_page, threshold
+
+
+def _encoded(pixels):
+    return pixels.astype(np.float32) / 255
+
+
+def _tables(quality):
+    buffer = io.BytesIO()
+    Image.new("RGB", (16, 16), (200, 190, 170)).save(buffer, format="JPEG", quality=quality)
+    buffer.seek(0)
+    with Image.open(buffer) as image:
+        return [list(table) for table in image.quantization.values()]
+
+
+def test_noise_bound_falls_with_quality():
+    noises = [noise_from_tables(_tables(quality)) for quality in (75, 85, 95, 98)]
+    assert noises == sorted(noises, reverse=True)
+    # libjpeg's q 85 table: about 5.8 levels of noise per pixel.
+    assert 5.0 < noises[1] * 255 < 6.5
+
+
+@pytest.mark.parametrize("quality", [75, 85, 95])
+def test_block_grid_is_found_in_a_decoded_jpeg_at_its_phase(quality):
+    _, jpeg, _ = scan_page(3, quality)
+    found = compression_evidence(_encoded(jpeg))
+    assert found.source == "block grid" and found.phase == (0, 0)
+    # The analysis window need not start on the grid.
+    shifted = compression_evidence(_encoded(jpeg[3:, 5:]))
+    assert shifted.source == "block grid" and shifted.phase == (5, 3)
+    # The table the grid's steps give is the file's within a factor of two.
+    bound = noise_from_tables(_tables(quality))
+    assert bound / 2 <= found.noise <= bound * 2
+
+
+@pytest.mark.parametrize("textured", [False, True])
+def test_lossless_pixels_show_no_compression(textured):
+    png, _, _ = scan_page(4, 85, textured=textured)
+    evidence = compression_evidence(_encoded(png))
+    assert evidence.source == NO_COMPRESSION.source and evidence.noise == 0 and not evidence.compressed
+    assert detect_block_grid(_encoded(png))[1] < detect_block_grid(_encoded(scan_page(4, 95)[1]))[1]
+
+
+def test_quantization_tables_are_read_from_jpeg_files_only(tmp_path):
+    png, jpeg, data = scan_page(5, 85)
+    (tmp_path / "o.jpg").write_bytes(data)
+    Image.fromarray(png).save(tmp_path / "o.png")
+    tables = aarecovery.read_quantization(tmp_path / "o.jpg")
+    assert tables is not None and len(tables[0]) == 64
+    assert aarecovery.read_quantization(tmp_path / "o.png") is None
+    assert aarecovery.read_quantization(tmp_path / "missing.jpg") is None
+    evidence = compression_evidence(_encoded(jpeg), tables)
+    assert evidence.source == "quantization tables"
+    assert evidence.noise == pytest.approx(noise_from_tables(_tables(85)))
+
+
+def test_the_command_line_passes_a_jpeg_files_tables_to_the_plan(tmp_path, capsys, monkeypatch):
+    import aarecovery.pipeline as pipeline
+    _, jpeg, data = scan_page(7, 75)
+    (tmp_path / "o.jpg").write_bytes(data)
+    Image.fromarray(threshold(jpeg)).save(tmp_path / "f.png")
+    reasons = []
+
+    def make_plan(*args, **kwargs):
+        plan = real_make_plan(*args, **kwargs)
+        reasons.append(plan.reason)
+        return plan
+
+    real_make_plan = pipeline.make_plan
+    monkeypatch.setattr(pipeline, "make_plan", make_plan)
+    assert main(["recover", str(tmp_path / "o.jpg"), str(tmp_path / "f.png"), "-o", str(tmp_path / "r.png"),
+                 "--backend", "numpy"]) == 0
+    assert "pure colours of thin features above JPEG (quantization tables, noise 9.7 levels)" in reasons[0]
+    engine = aarecovery.Engine("numpy")
+    try:
+        engine.set_images(jpeg, threshold(jpeg), quantization=aarecovery.read_quantization(tmp_path / "o.jpg"))
+        assert "JPEG (quantization tables" in engine.plan().reason
+        engine.set_images(jpeg, threshold(jpeg))
+        assert "JPEG (block grid" in engine.plan().reason
+    finally:
+        engine.release()
+
+
+def test_a_batch_reads_the_tables_of_jpeg_originals(tmp_path):
+    _, jpeg, data = scan_page(7, 75)
+    (tmp_path / "o.jpg").write_bytes(data)
+    Image.fromarray(threshold(jpeg)).save(tmp_path / "f.png")
+    from_file, from_array = aarecovery.recover_many([(tmp_path / "o.jpg", tmp_path / "f.png", "file.png"),
+                                                     (jpeg, threshold(jpeg), "array.png")], backend="numpy")
+    assert "JPEG (quantization tables" in from_file.reason
+    assert "JPEG (block grid" in from_array.reason
+
+
+def _pages(count, seed):
+    rng = np.random.default_rng(seed)
+    for index in range(count):
+        yield int(rng.integers(1 << 30)), int(rng.integers(75, 96)), bool(index % 2)
+
+
+@pytest.mark.parametrize("page_seed, quality, textured", list(_pages(8, 19)))
+def test_no_paper_grain_reaches_fs_flat_background(page_seed, quality, textured):
+    # Random JPEG scans of text on tinted or textured paper, thresholded: where F is white
+    # and the clean page is bare paper, R must stay white (within 10 levels).
+    png, jpeg, _ = scan_page(page_seed, quality, textured=textured)
+    filtered = threshold(jpeg)
+    recovered = aarecovery.recover(jpeg, filtered, backend="numpy")
+    assert haze(recovered, filtered, png) == 0
+
+
+def test_without_the_noise_contrast_the_grain_does_reach_the_background(monkeypatch):
+    # The property above is not vacuous: with the contrast floor of lossless inputs alone,
+    # the ringing next to the letters is extended to ink on the same kind of page.
+    import aarecovery.plan.compression as compression
+    png, jpeg, _ = scan_page(7, 75)
+    filtered = threshold(jpeg)
+    assert NOISE_CONTRAST_SIGMAS > 0
+    monkeypatch.setattr(compression, "NOISE_CONTRAST_SIGMAS", 0.0)
+    monkeypatch.setattr(compression, "MIN_NOISE_CONTRAST", 0.0)
+    assert haze(aarecovery.recover(jpeg, filtered, backend="numpy"), filtered, png) > 100
+
+
+def _jpeg_round_trip(pixels, quality):
+    buffer = io.BytesIO()
+    Image.fromarray(pixels).save(buffer, format="JPEG", quality=quality)
+    buffer.seek(0)
+    with Image.open(buffer) as decoded:
+        return np.asarray(decoded.convert("RGB"))
+
+
+@pytest.mark.parametrize("quality", [75, 90])
+def test_a_jpeg_drawing_is_hard_edged_and_a_jpeg_photo_textured(quality):
+    # The pixel grain reads a JPEG page's ringing as texture; the edge-free blocks of its
+    # grid are flat, where a photo's keep their shading.
+    from importlib import resources
+
+    from aarecovery.lab.realtools import render_family
+    from aarecovery.plan.resample import box_downsample
+    from aarecovery.plan.texture import grain, is_textured
+    page = np.rint(box_downsample(render_family("serif", 96), 8, "linear") * 255).astype(np.uint8)
+    page = _encoded(_jpeg_round_trip(page, quality))
+    evidence = compression_evidence(page)
+    assert grain(page) > 0.05
+    assert is_textured(page, 0.0, evidence) == (False, is_textured(page, 0.0, evidence)[1])
+    with resources.files("aarecovery").joinpath("data/photo_camera.png").open("rb") as handle:
+        photo = np.asarray(Image.open(handle).convert("RGB"))[:256, :256]
+    photo = _encoded(_jpeg_round_trip(np.ascontiguousarray(photo[::2, ::2]), quality))
+    evidence = compression_evidence(photo)
+    assert evidence.compressed
+    assert is_textured(photo, 0.0, evidence)[0]
