@@ -147,6 +147,40 @@ def _target_rows(results, summary):
     pixels, cases = outside.get("R", (0, 0))
     rows.append(("5. R pixels outside F's 3 x 3 colour range", f"{pixels} in {cases} cases",
                  ", ".join(f"{m} {outside[m][0]}" for m in outside if m != "R"), "0", met(pixels == 0)))
+    return rows + _region_rows(summary, others, met)
+
+
+def _region_rows(summary, others, met):
+    """The local plan's targets: mixed content per region, neighbourhood filters, haze."""
+    rows = []
+    for key, which in (("mixed", "every filter"), ("mixed_pointwise", "point-wise filters")):
+        mixed = summary.get(key)
+        if not mixed or not any(mixed[region][1] for region in REGIONS):
+            continue
+        text, photo = (mixed[region] for region in REGIONS)
+        rows.append((f"6. mixed content under {which}: text and graphics regions ({text[1]} cases)",
+                     _reduction(text[0].get("R", np.nan)).strip(), others(text[0]), f"{MIN_TEXT_REDUCTION}",
+                     met(text[0].get("R", -np.inf) >= MIN_TEXT_REDUCTION)))
+        rows.append((f"6. mixed content under {which}: photo regions worse than F ({photo[1]} cases)",
+                     f"{len(photo[2])} (mean {_reduction(photo[0].get('R', np.nan)).strip()})", others(photo[0]),
+                     "0", met(not photo[2])))
+        overall, cases = mixed["overall"]
+        rows.append((f"6. mixed content under {which}: whole edge band ({cases} cases)",
+                     _reduction(overall.get("R", np.nan)).strip(), others(overall), f"{MIN_MIXED_REDUCTION}",
+                     met(overall.get("R", -np.inf) >= MIN_MIXED_REDUCTION)))
+    if summary.get("neighbourhood_cases"):
+        near = summary["neighbourhood"]
+        loss, where = summary["neighbourhood_worst_db"]
+        rows.append((f"7. neighbourhood filters on drawings, PNG ({summary['neighbourhood_cases']} cases)",
+                     f"{_reduction(near.get('R', np.nan)).strip()}; worst loss {loss:+.2f} dB ({where})", others(near),
+                     f"{MIN_NEIGHBOURHOOD_REDUCTION}, no loss",
+                     met(near.get("R", -np.inf) >= MIN_NEIGHBOURHOOD_REDUCTION and loss <= 0)))
+    haze = summary.get("haze", {}).get("jpeg")
+    if haze and "R" in haze:
+        pixels, hazed, cases = haze["R"]
+        rows.append((f"8. JPEG scans: paper pixels R makes darker than F ({cases} cases)", f"{pixels} in {hazed} cases",
+                     ", ".join(f"{m} {haze[m][0]}" for m in haze if m not in ("R", "paper_pixels")), "0",
+                     met(pixels == 0)))
     return rows
 
 
