@@ -71,24 +71,31 @@ def test_the_command_line_passes_a_jpeg_files_tables_to_the_plan(tmp_path, capsy
     _, jpeg, data = scan_page(7, 75)
     (tmp_path / "o.jpg").write_bytes(data)
     Image.fromarray(threshold(jpeg)).save(tmp_path / "f.png")
-    reasons = []
+    tables = aarecovery.read_quantization(tmp_path / "o.jpg")
+    plans = []
 
     def make_plan(*args, **kwargs):
         plan = real_make_plan(*args, **kwargs)
-        reasons.append(plan.reason)
+        plans.append((kwargs.get("quantization"), plan))
         return plan
 
     real_make_plan = pipeline.make_plan
     monkeypatch.setattr(pipeline, "make_plan", make_plan)
     assert main(["recover", str(tmp_path / "o.jpg"), str(tmp_path / "f.png"), "-o", str(tmp_path / "r.png"),
                  "--backend", "numpy"]) == 0
-    assert "pure colours of thin features above JPEG (quantization tables, noise 9.7 levels)" in reasons[0]
+    passed, plan = plans[0]
+    assert passed == tables and plan.decision == aarecovery.Decision.POINTWISE_HARD_EDGED_COMPRESSED
+    # The tables' noise (9.7 levels at q 75) sets the least contrast of a thin feature.
+    from_tables = compression_evidence(_encoded(jpeg), tables)
+    assert from_tables.source == "quantization tables"
+    assert plan.pure_colours.noise_contrast == pytest.approx(from_tables.contrast)
     engine = aarecovery.Engine("numpy")
     try:
-        engine.set_images(jpeg, threshold(jpeg), quantization=aarecovery.read_quantization(tmp_path / "o.jpg"))
-        assert "JPEG (quantization tables" in engine.plan().reason
+        engine.set_images(jpeg, threshold(jpeg), quantization=tables)
+        assert engine.plan().pure_colours.noise_contrast == pytest.approx(from_tables.contrast)
         engine.set_images(jpeg, threshold(jpeg))
-        assert "JPEG (block grid" in engine.plan().reason
+        assert engine.plan().decision == aarecovery.Decision.POINTWISE_HARD_EDGED_COMPRESSED
+        assert compression_evidence(_encoded(jpeg)).source == "block grid"
     finally:
         engine.release()
 
@@ -99,6 +106,8 @@ def test_a_batch_reads_the_tables_of_jpeg_originals(tmp_path):
     Image.fromarray(threshold(jpeg)).save(tmp_path / "f.png")
     from_file, from_array = aarecovery.recover_many([(tmp_path / "o.jpg", tmp_path / "f.png", "file.png"),
                                                      (jpeg, threshold(jpeg), "array.png")], backend="numpy")
+    assert from_file.decision == from_array.decision == "pointwise-hard-edged-compressed"
+    # The report says which evidence the plan read: the file's tables, or the grid in the array.
     assert "JPEG (quantization tables" in from_file.reason
     assert "JPEG (block grid" in from_array.reason
 
