@@ -80,7 +80,7 @@ def run(args):
     print(format_table(results, missing, label))
     print(f"\n{len(results)} cases in {time.perf_counter() - start:.1f} s")
     if args.report:
-        command = "aarecovery eval" + (" --quick" if args.quick else "")
+        command = "aarecovery eval" + (" --quick" if args.quick else "") + (" --no-peers" if args.no_peers else "")
         print(f"report: {write_report(results, args.report, missing, command, label)}")
     return 0
 
@@ -121,7 +121,9 @@ def _run_realtools(args):
     print(format_realtools(results, missing_tools, missing_peers, suite_name=suite.name, half=half))
     print(f"\n{len(results)} cases in {time.perf_counter() - start:.1f} s")
     if args.report:
-        command = "aarecovery eval --suite realtools" + (" --quick" if args.quick else "") + f" --half {half}"
+        # The options that shape the tables, so that the block's command regenerates it.
+        command = ("aarecovery eval --suite realtools" + (" --quick" if args.quick else "") + f" --half {half}"
+                   + (" --no-peers" if args.no_peers else ""))
         path = write_realtools_report(results, args.report, missing_tools, missing_peers, suite_name=suite.name,
                                       half=half, command=command)
         print(f"report: {path}")
