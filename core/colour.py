@@ -5,7 +5,7 @@ The GL backend has the same functions once, in ``backends/gl/shaders/colour.glsl
 
 import numpy as np
 
-__all__ = ["LUMA", "LUMA_WEIGHTS", "LUMINANCE_D50", "luma", "srgb_to_linear", "linear_to_srgb"]
+__all__ = ["LUMA", "LUMA_WEIGHTS", "REC601_LUMA", "LUMINANCE_D50", "luma", "srgb_to_linear", "linear_to_srgb"]
 
 #: Rec. 709 / sRGB weights of R, G and B: luminance of linear light, and the "luma" of
 #: encoded values that image editors compute. Python floats, so that float32 and float64
@@ -13,6 +13,10 @@ __all__ = ["LUMA", "LUMA_WEIGHTS", "LUMINANCE_D50", "luma", "srgb_to_linear", "l
 LUMA = (0.2126, 0.7152, 0.0722)
 #: :data:`LUMA` as float32, for products with float32 colour.
 LUMA_WEIGHTS = np.array(LUMA, np.float32)
+#: Rec. 601 weights of R, G and B, on encoded values: the grey of JPEG's YCbCr, of OpenCV
+#: (``cv2.applyColorMap`` on a colour image), Pillow's ``convert("L")`` and ImageMagick's
+#: ``Rec601Luma``.
+REC601_LUMA = (0.299, 0.587, 0.114)
 #: Luminance (Y) of linear sRGB adapted to D50, as babl computes it for GEGL and GIMP
 #: (gegl:threshold, gegl:gray): the real-tools suite found GEGL's threshold to be exactly a
 #: threshold of the encoded value of this Y.

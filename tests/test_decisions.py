@@ -6,7 +6,7 @@ import pytest
 
 import aarecovery
 from aarecovery import Decision
-from aarecovery.colour import linear_to_srgb, srgb_to_linear
+from aarecovery.colour import LUMA_WEIGHTS, linear_to_srgb, srgb_to_linear
 from aarecovery.lab import scenes as _scenes
 from aarecovery.lab.groundtruth import make_case
 from aarecovery.lab.realtools import render_family
@@ -52,7 +52,7 @@ def _jpeg_page_thresholded(quality=85):
     buffer.seek(0)
     with Image.open(buffer) as decoded:
         original = np.asarray(decoded.convert("RGB")).astype(np.float32) / 255
-    luma = original @ np.array([0.2126, 0.7152, 0.0722], np.float32)
+    luma = original @ LUMA_WEIGHTS
     filtered = np.repeat((luma > 0.5)[..., None], 3, axis=-1).astype(np.float32)
     return original, filtered
 

@@ -6,6 +6,7 @@ encoded values (what a viewer sees), all channels together.
 
 import numpy as np
 
+from ..colour import LUMA_WEIGHTS
 from ..filters.spatial import gaussian_filter
 from ..spec.sobel import image_gradients
 
@@ -22,7 +23,7 @@ _PSNR_CAP = 100.0
 #: How much darker than F a background pixel may come out before it counts as haze: two
 #: 8-bit steps of luma, above the rounding of any repair but far below a visible blotch.
 HAZE_TOLERANCE = 2.0 / 255
-_LUMA = np.array([0.2126, 0.7152, 0.0722], np.float32)  # Rec. 709, on encoded values
+_LUMA = LUMA_WEIGHTS  # Rec. 709, on encoded values
 
 
 def mse(a, b, mask=None):

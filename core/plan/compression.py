@@ -28,6 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..colour import REC601_LUMA
+
 __all__ = ["quiet_block_grain", "BLOCK_GRAIN_SHARE", "CompressionEvidence", "NO_COMPRESSION", "BLOCK", "noise_from_tables", "detect_block_grid",
            "compression_evidence", "GRID_MARGIN", "STANDARD_LUMA_TABLE",
            "NOISE_CONTRAST_SIGMAS", "MIN_NOISE_CONTRAST",
@@ -209,7 +211,7 @@ def detect_block_grid(encoded):
         The standard luma table scaled to the steps measured at low frequencies on the grid
         (None when undecided).
     """
-    luma = encoded[..., :3].astype(np.float64) @ np.array([0.299, 0.587, 0.114]) * 255.0
+    luma = encoded[..., :3].astype(np.float64) @ np.array(REC601_LUMA) * 255.0
     if min(luma.shape) < 2 * BLOCK:
         return (0, 0), 0.0, None
     shares = np.full((BLOCK, BLOCK), -1.0)
@@ -267,7 +269,7 @@ def quiet_block_grain(encoded, evidence):
     float or None
         None when fewer than 16 blocks are free of edges.
     """
-    luma = encoded[..., :3].astype(np.float64) @ np.array([0.299, 0.587, 0.114]) * 255.0
+    luma = encoded[..., :3].astype(np.float64) @ np.array(REC601_LUMA) * 255.0
     row, column = evidence.phase
     rows, columns = (luma.shape[0] - row) // BLOCK, (luma.shape[1] - column) // BLOCK
     blocks = luma[row:row + rows * BLOCK, column:column + columns * BLOCK]

@@ -9,7 +9,7 @@ restore thin features' pure colours (``plan.pure_colours``) or calibrate the str
 
 import numpy as np
 
-from ..colour import LUMA, luma, srgb_to_linear
+from ..colour import LUMA, REC601_LUMA, luma, srgb_to_linear
 from ..spec.pure_colours import LUMINANCE_KEYS, SCALE_KEYS, key_values, scale_transfer
 
 __all__ = ["PointwiseTransfer", "fit_pointwise", "filled_bins", "key_of", "POINTWISE_SHARE", "TABLE_KEYS"]
@@ -26,10 +26,9 @@ POINTWISE_SHARE = 0.97
 #: Rec. 601 luma, the grey of OpenCV (``cv2.applyColorMap`` on a colour image, its gradient
 #: maps), Pillow's ``convert("L")`` and ImageMagick's ``Rec601Luma``.
 TABLE_KEYS = ("channel", "luma", "mean", "max") + tuple(LUMINANCE_KEYS) + ("luma601",)
-# Rec. 601 luma weights. A TURBO-like gradient map of a colour photo's Rec. 601 grey matched
-# 0.62 of the edge pixels by Rec. 709 luma, so the safe plan called it a neighbourhood
-# filter and kept F.
-_REC601_LUMA = (0.299, 0.587, 0.114)
+# Rec. 601 luma (colour.REC601_LUMA): a TURBO-like gradient map of a colour photo's Rec. 601
+# grey matched 0.62 of the edge pixels by Rec. 709 luma, so the safe plan called it a
+# neighbourhood filter and kept F.
 
 
 def key_of(colour, key):
@@ -45,7 +44,7 @@ def key_of(colour, key):
     if key == "luma601":
         # The 8-bit grey those tools index their map by, at its bin's centre: binned raw, a
         # bin straddled two grey levels and a steep map missed (0.965 of the edges matched).
-        grey = np.rint(np.clip(colour @ np.array(_REC601_LUMA, np.float32), 0, 1) * 255)
+        grey = np.rint(np.clip(colour @ np.array(REC601_LUMA, np.float32), 0, 1) * 255)
         return ((grey + np.float32(0.5)) / np.float32(_LUT_BINS)).astype(np.float32)
     planes = np.ascontiguousarray(colour.reshape(-1, 3).T, dtype=np.float32)
     return key_values(planes, key)[0].reshape(colour.shape[:-1])
