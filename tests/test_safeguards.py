@@ -142,3 +142,23 @@ def test_repair_to_error_ratio_weighs_the_repair_against_the_models_error(scene)
     thresholded = repair_to_error_ratio(rgba(case.original), rgba(case.filtered), **sigmas)
     assert identity == pytest.approx(1.0, abs=1e-3)
     assert thresholded > 50 * MIN_REPAIR_TO_ERROR
+
+
+def test_a_grey_drawing_stretched_in_its_encoded_values_is_kept():
+    # A grey image cannot tell its antialiasing space, so the plan blends in linear light; a
+    # levels stretch of its encoded values (Pillow's autocontrast) is affine there only in
+    # sRGB values, and its edges are already right if it was antialiased in sRGB values.
+    size, k = 64, 8
+    y, x = np.mgrid[0:size * k, 0:size * k] / k
+    scene = np.full((size * k, size * k), 0.85, np.float32)
+    scene[np.hypot(y - 30, x - 28) < 17] = 0.1
+    scene[(np.abs(y - x * 0.6 - 12) < 0.6) | (np.abs(x - 50) < 0.4)] = 0.05
+    original = scene.reshape(size, k, size, k).mean((1, 3))
+    original = np.repeat(np.round(original * 255)[..., None], 3, -1).astype(np.uint8)
+    low, high = int(original.min()), int(original.max())
+    filtered = np.round((original.astype(np.float32) - low) * 255 / (high - low)).astype(np.uint8)
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(original, filtered)
+        plan = engine.plan()
+        assert plan.decision == Decision.AFFINE_KEPT, plan.reason
+        np.testing.assert_array_equal(aarecovery.recover(original, filtered, engine=engine), filtered)

@@ -10,8 +10,8 @@ colour lines better), then takes the first of these exits that applies, each nam
 
 1. ``LOWPASS_KEPT`` (``lowpass``): F is a blur of O; F's soft edges are the filter's
    intent and F is kept.
-2. ``AFFINE_KEPT`` (``linearity``): F is an affine map of O on O's edges; they are already
-   right and F is kept.
+2. ``AFFINE_KEPT`` (``linearity``): F is an affine map of O on O's edges (in the blend
+   space, and for a grey O also in sRGB values); they are already right and F is kept.
 3. ``POINTWISE_HARD_EDGED_COMPRESSED`` (``pointwise``, ``texture``, ``compression``):
    ``F = f(O)`` for a fitted table on hard-edged content whose O was JPEG-compressed (its
    file's tables, or the block grid in its pixels): the calibrated strength, since the
@@ -77,6 +77,9 @@ _ANALYSIS_SIDE = 512
 # method lost up to 3.4 dB there (unsharp mask, colour replacement) and gained at most 1 dB
 # (bilateral); no strength was safe for all, so F is kept.
 _PHOTO_NEIGHBOURHOOD_STRENGTH = 0.0
+# Channels within this everywhere: a grey (or faintly tinted) image, whose colour lines cannot
+# tell the antialiasing space; the manga pages' cream paper differs by 3 levels.
+_NEAR_GREY = 4.0 / 255
 
 
 @dataclass(frozen=True)
@@ -165,11 +168,19 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         return PairAnalysis(space, 0.0, f"F is a low-pass (blur) of O (kernel residual {kernel_residual:.3f}): kept F",
                             Decision.LOWPASS_KEPT, forcing=forcing_advice(Decision.LOWPASS_KEPT))
     edges = gradient_magnitude(o) >= EDGE_GRADIENT
-    affine = affine_share(o, f, edges, space)
-    if affine >= AFFINE_SHARE:
-        return PairAnalysis(space, 0.0, f"F is an affine map of O in {space} values on {affine:.3f} of the edges, "
-                                        "so its edges are already right: kept F", Decision.AFFINE_KEPT,
-                            forcing=forcing_advice(Decision.AFFINE_KEPT))
+    # A grey (or faintly tinted) O cannot tell its antialiasing space (blend_space falls back to linear light), so
+    # an affine map of its encoded values (Pillow's autocontrast, a levels stretch) is tested
+    # too: tuning half, the screentone manga under Pillow's autocontrast, affine in sRGB values
+    # on 1.000 of its edges and 0.87-0.92 in linear light, lost 10.2 dB against F at the
+    # calibrated strength (antialiased in sRGB) and gained 0.23 (in linear light); kept, both
+    # are F.
+    affine_spaces = (space, "srgb") if space == "linear" and _is_grey(o) else (space,)
+    for affine_space in affine_spaces:
+        affine = affine_share(o, f, edges, affine_space)
+        if affine >= AFFINE_SHARE:
+            return PairAnalysis(space, 0.0, f"F is an affine map of O in {affine_space} values on {affine:.3f} of the "
+                                            "edges, so its edges are already right: kept F", Decision.AFFINE_KEPT,
+                                forcing=forcing_advice(Decision.AFFINE_KEPT))
     transfer = fit_pointwise(o, f, edges)
     compression = compression_evidence(o, quantization)
     textured, texture = is_textured(o, fit, compression)
@@ -252,6 +263,11 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                     f"{ratio:.1f}): full strength"
                                     + (f", pure colours of thin features ({kept})" if prior is not None else ""),
                         Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
+
+
+def _is_grey(encoded):
+    """True when every pixel's channels are equal to within :data:`_NEAR_GREY`."""
+    return bool((encoded.max(axis=-1) - encoded.min(axis=-1)).max() <= _NEAR_GREY)
 
 
 def _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e):
