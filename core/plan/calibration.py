@@ -10,6 +10,7 @@ edges are already blends, and box2(F) keeps F's damage) and is not used there.
 
 import numpy as np
 
+from ..colour import largest_channel
 from ..spec import from_working_space, recover_working, to_working_space
 from ..spec.sobel import gradient_magnitude
 from .resample import box_downsample
@@ -62,7 +63,7 @@ def calibrate_strength(original, transfer, filtered, space, sigma_d, sigma_e, it
     work_o = to_working_space(o2_rgba, blend_space=space)
     work_f = to_working_space(f2_rgba, blend_space=space)
     gradient = gradient_magnitude(o2)
-    band = (np.abs(f2 - target).max(axis=-1) > 1 / 255) | (gradient.max() > 0) & (gradient >= EDGE_GRADIENT)
+    band = (largest_channel(np.abs(f2 - target)) > 1 / 255) | (gradient.max() > 0) & (gradient >= EDGE_GRADIENT)
     if not band.any():
         return 1.0, {}
 

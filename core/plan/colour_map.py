@@ -16,6 +16,8 @@ the mean of their filled neighbours, grown outwards.
 
 import numpy as np
 
+from ..colour import largest_channel
+
 __all__ = ["ColourMapTransfer", "fit_colour_map", "COLOUR_MAP_SHARE"]
 
 # Bins per channel: 8/255 wide, not swept. Finer bins hold fewer pixels each to leave one out
@@ -95,7 +97,7 @@ def fit_colour_map(original, filtered, edges):
     shared = counts[own_bin] > 1
     if shared.any():
         others = (sums[own_bin[shared]] - own_f[shared]) / (counts[own_bin[shared]] - 1)[:, None]
-        consistency = float((np.abs(others - own_f[shared]).max(axis=-1) <= _MATCH).mean())
+        consistency = float((largest_channel(np.abs(others - own_f[shared])) <= _MATCH).mean())
     else:
         consistency = 0.0
     filled = (counts > 0).reshape((_BINS,) * 3)

@@ -27,6 +27,7 @@ even where it keeps the greys of the image.
 
 import numpy as np
 
+from ..colour import largest_channel
 from ..spec.pure_colours import PureColourPrior
 from .pure_colours import palette_of
 
@@ -67,7 +68,7 @@ def _deep_flat(original):
     flat = np.ones((height, width), bool)
     for dy in range(-r, r + 1):
         for dx in range(-r, r + 1):
-            flat &= np.abs(padded[r + dy:r + dy + height, r + dx:r + dx + width] - original).max(-1) \
+            flat &= largest_channel(np.abs(padded[r + dy:r + dy + height, r + dx:r + dx + width] - original)) \
                 <= _FLAT_TOLERANCE
     return flat
 
@@ -88,7 +89,7 @@ def flat_kept_share(original, filtered):
     flat = _deep_flat(original)
     if flat.sum() < _MIN_FLAT_PIXELS:
         return 0.0
-    kept = np.abs(filtered[flat] - original[flat]).max(axis=-1) <= _KEPT_TOLERANCE
+    kept = largest_channel(np.abs(filtered[flat] - original[flat])) <= _KEPT_TOLERANCE
     return float(kept.mean())
 
 

@@ -11,7 +11,7 @@ squares on O's pixels and counts the edge pixels the fit explains.
 
 import numpy as np
 
-from ..colour import linear_to_srgb, srgb_to_linear
+from ..colour import largest_channel, linear_to_srgb, srgb_to_linear
 
 __all__ = ["affine_share", "AFFINE_SHARE", "AFFINE_TOLERANCE"]
 
@@ -47,5 +47,5 @@ def affine_share(original, filtered, edges, blend_space):
     predicted = np.clip(design[edges.ravel()] @ coefficients, 0, 1).astype(np.float32)
     if blend_space == "linear":
         predicted = linear_to_srgb(predicted)
-    miss = np.abs(predicted - filtered.reshape(-1, 3)[edges.ravel()]).max(axis=-1)
+    miss = largest_channel(np.abs(predicted - filtered.reshape(-1, 3)[edges.ravel()]))
     return float((miss <= AFFINE_TOLERANCE).mean())

@@ -9,7 +9,7 @@ restore thin features' pure colours (``plan.pure_colours``) or calibrate the str
 
 import numpy as np
 
-from ..colour import LUMA, REC601_LUMA, luma, srgb_to_linear
+from ..colour import LUMA, REC601_LUMA, largest_channel, luma, srgb_to_linear
 from ..spec.pure_colours import LUMINANCE_KEYS, SCALE_KEYS, key_values, scale_transfer
 
 __all__ = ["PointwiseTransfer", "fit_pointwise", "filled_bins", "key_of", "POINTWISE_SHARE", "TABLE_KEYS"]
@@ -40,7 +40,7 @@ def key_of(colour, key):
     if key == "mean":
         return colour.mean(axis=-1)
     if key == "max":
-        return colour.max(axis=-1)
+        return largest_channel(colour)
     if key == "luma601":
         # The 8-bit grey those tools index their map by, at its bin's centre: binned raw, a
         # bin straddled two grey levels and a steep map missed (0.965 of the edges matched).
@@ -107,7 +107,7 @@ def fit_pointwise(original, filtered, edges):
     scored_o, scored_f = original[scored], filtered[scored]
 
     def consistency(transfer):
-        miss = np.abs(transfer(scored_o) - scored_f).max(axis=-1)
+        miss = largest_channel(np.abs(transfer(scored_o) - scored_f))
         # Ties (two colours fit any key) go to the key that reproduces F more closely.
         transfer.mean_miss = float(miss.mean())
         return float((miss <= _LUT_TOLERANCE).mean())
@@ -181,17 +181,45 @@ def _scale_tables(original, filtered, key):
         return np.repeat(column[:, None], 3, axis=1).astype(np.float32)
 
     own = result @ weights
-    unclipped = result.max(axis=-1) < 1 - 1 / 512
+    unclipped = largest_channel(result) < 1 - 1 / 512
     has_unclipped = np.bincount(index[unclipped], minlength=_LUT_BINS) > 0
     first = unclipped | ~has_unclipped[index]
-    usable = (result < 1 - 1 / 512) & (source > 1e-4)
-    channel = np.argmax(np.where(usable, source, -1), axis=-1)
-    rows = np.arange(len(source))
-    ratio = result[rows, channel] / np.maximum(source[rows, channel], 1e-4)
-    scaled = np.where(source_luma > 1e-6, ratio * source_luma, result.mean(axis=-1))
-    second = usable.any(axis=-1) | (source_luma <= 1e-6)
+    scaled, second = _scaled_luma(source, result, source_luma)
     return tuple(table(values, use, at_mean_key) for values, use in ((own, first), (scaled, second))
                  for at_mean_key in (False, True))
+
+
+def _scaled_luma(source, result, source_luma):
+    """Each pixel's scale (F / O in its largest channel that F did not clip) times its luma,
+    and which pixels have one, for :func:`_scale_tables`.
+
+    Channel by channel, not by NumPy's reductions over the last axis (its slowest): the first
+    channel of largest usable source, as ``argmax`` picks it, and the mean as ``mean`` sums
+    it, bit for bit.
+
+    Parameters
+    ----------
+    source, result : ndarray of float64, shape (N, 3)
+        O's and F's values.
+    source_luma : ndarray of float64, shape (N,)
+
+    Returns
+    -------
+    scaled : ndarray of float64, shape (N,)
+        The scaled luma; F's mean where O is black.
+    usable : ndarray of bool, shape (N,)
+        Pixels with a channel F did not clip, or black in O.
+    """
+    usable = (result < 1 - 1 / 512) & (source > 1e-4)
+    candidates = np.where(usable, source, -1)
+    largest = largest_channel(candidates)
+    first_is, second_is = candidates[:, 0] == largest, candidates[:, 1] == largest
+    picked_source, picked_result = (np.where(first_is, values[:, 0], np.where(second_is, values[:, 1], values[:, 2]))
+                                    for values in (source, result))
+    ratio = picked_result / np.maximum(picked_source, 1e-4)
+    mean_result = (result[:, 0] + result[:, 1] + result[:, 2]) / 3
+    scaled = np.where(source_luma > 1e-6, ratio * source_luma, mean_result)
+    return scaled, usable[:, 0] | usable[:, 1] | usable[:, 2] | (source_luma <= 1e-6)
 
 
 def filled_bins(original, key):

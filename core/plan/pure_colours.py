@@ -10,6 +10,7 @@ import dataclasses
 
 import numpy as np
 
+from ..colour import largest_channel
 from ..params import SIGMA_D, SIGMA_E
 from ..spec import to_working_space
 from ..spec.pure_colours import (EXTENSION_KEYS, PALETTE_SIZE, PureColourPrior, filtered_colour,
@@ -71,7 +72,7 @@ def palette_of(original):
     flat = np.ones((height, width), bool)
     for dy in (-1, 0, 1):
         for dx in (-1, 0, 1):
-            flat &= np.abs(padded[1 + dy:1 + dy + height, 1 + dx:1 + dx + width] - original).max(-1) \
+            flat &= largest_channel(np.abs(padded[1 + dy:1 + dy + height, 1 + dx:1 + dx + width] - original)) \
                 <= _FLAT_TOLERANCE
     levels = np.rint(np.clip(original[flat], 0, 1) * 255).astype(np.int64)
     if not len(levels):
@@ -168,7 +169,7 @@ def affine_in_key_miss(original, filtered, edges, key):
         design = np.stack([x, np.ones_like(x)], axis=1)
         coefficients, *_ = np.linalg.lstsq(design, target[:, c], rcond=None)
         miss[:, c] = np.abs(design @ coefficients - target[:, c])
-    return float(miss.max(axis=1).mean())
+    return float(largest_channel(miss).mean())
 
 
 def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None, noise_contrast=0.0):

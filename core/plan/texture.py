@@ -28,6 +28,7 @@ that hold an edge, so that a JPEG drawing is flat there and a photo is not.
 
 import numpy as np
 
+from ..colour import largest_channel
 from ..spec.sobel import gradient_magnitude
 from .compression import BLOCK_GRAIN_SHARE, quiet_block_grain
 
@@ -81,9 +82,9 @@ def grain(encoded):
     if quiet.sum() < _MIN_QUIET:
         return None
     window = _neighbours(encoded)
-    spread = (np.max(window, axis=0) - np.min(window, axis=0)).max(axis=-1)
+    spread = largest_channel(np.max(window, axis=0) - np.min(window, axis=0))
     high_pass = _neighbours(encoded - np.mean(window, axis=0))
-    high_pass_spread = (np.max(high_pass, axis=0) - np.min(high_pass, axis=0)).max(axis=-1)
+    high_pass_spread = largest_channel(np.max(high_pass, axis=0) - np.min(high_pass, axis=0))
     grainy = (spread > _GRAIN_RANGE) & (high_pass_spread > _GRAIN_HIGH_PASS)
     return float(grainy[quiet].mean())
 

@@ -1,0 +1,76 @@
+"""The safe plan's faster formulations give bit for bit what the direct NumPy ones gave.
+
+The plan's decisions compare its figures with thresholds, so a speed-up may not move them by
+an ulp: each is checked here against the formula it replaced.
+"""
+
+import io
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from aarecovery.colour import REC601_LUMA, largest_channel
+from aarecovery.plan import compression, pointwise
+
+from jpeg_scans import scan_page
+
+
+@pytest.mark.parametrize("shape", [(7, 3), (5, 6, 4), (9, 2, 1), (64,)])
+def test_largest_channel_is_max_over_the_last_axis(shape):
+    values = np.random.default_rng(1).normal(size=shape).astype(np.float32)
+    values.flat[::5] = np.nan
+    np.testing.assert_array_equal(largest_channel(values), values.max(axis=-1))
+
+
+def _jpeg_luma(quality):
+    _, page, _ = scan_page(2, quality)
+    buffer = io.BytesIO()
+    Image.fromarray(np.ascontiguousarray(page[5:, 3:])).save(buffer, format="JPEG", quality=quality)
+    buffer.seek(0)
+    with Image.open(buffer) as decoded:
+        pixels = np.asarray(decoded.convert("RGB")).astype(np.float64)
+    return pixels @ np.array(REC601_LUMA)
+
+
+@pytest.mark.parametrize("quality", [75, 95])
+def test_the_grid_search_dcts_and_busy_blocks_are_the_direct_ones(quality):
+    luma = _jpeg_luma(quality)
+    dct = compression._DCT
+    block = compression.BLOCK
+    for row in range(block):
+        shared = compression._column_transforms(luma, row)
+        for column in range(block):
+            rows, columns = (luma.shape[0] - row) // block, (luma.shape[1] - column) // block
+            blocks = luma[row:row + rows * block, column:column + columns * block]
+            blocks = blocks.reshape(rows, block, columns, block).transpose(0, 2, 1, 3).reshape(-1, block, block)
+            direct = dct @ blocks @ dct.T
+            np.testing.assert_array_equal(compression._block_dct(luma, row, column, shared), direct)
+            busy = np.abs(direct.reshape(len(direct), -1)[:, 1:]).max(axis=1) > compression._BUSY_COEFFICIENT
+            assert busy.any() and not busy.all()
+            np.testing.assert_array_equal(compression._busy(direct), busy)
+
+
+def _direct_scaled_luma(source, result, source_luma):
+    """The scaled luma as the scale tables computed it with NumPy's reductions over the last axis."""
+    usable = (result < 1 - 1 / 512) & (source > 1e-4)
+    channel = np.argmax(np.where(usable, source, -1), axis=-1)
+    rows = np.arange(len(source))
+    ratio = result[rows, channel] / np.maximum(source[rows, channel], 1e-4)
+    scaled = np.where(source_luma > 1e-6, ratio * source_luma, result.mean(axis=-1))
+    return scaled, usable.any(axis=-1) | (source_luma <= 1e-6)
+
+
+def test_the_scaled_luma_is_that_of_the_direct_formulas():
+    rng = np.random.default_rng(3)
+    source = rng.random((5000, 3))
+    source[::4] = 0
+    source[::7, 1] = 1
+    source[::5, 1:] = source[::5, :1]  # ties between channels: the first wins
+    result = np.clip(source * rng.uniform(0.5, 2, (5000, 1)), 0, 1)
+    result[::9, 2] = rng.random(len(result[::9]))
+    source_luma = source @ np.array([0.2126, 0.7152, 0.0722])
+    fast, direct = pointwise._scaled_luma(source, result, source_luma), _direct_scaled_luma(source, result, source_luma)
+    for a, b in zip(fast, direct):
+        np.testing.assert_array_equal(a, b)
+    assert 0 < direct[1].mean() < 1 and (source_luma <= 1e-6).any()
