@@ -128,8 +128,10 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     # analysis reads the window that aarecovery.sample chooses, as a streamed pair does.
     try:
         if plan is None:
-            plan = make_plan(*array_sample(original, filtered), parameters, mode=mode, linear=linear,
-                             blend_space=blend_space, quantization=quantization)
+            # The paper's method reads nothing of the pair: no window to choose (50 ms at 4096^2).
+            pair = array_sample(original, filtered) if mode == "safe" else (original, filtered)
+            plan = make_plan(*pair, parameters, mode=mode, linear=linear, blend_space=blend_space,
+                             quantization=quantization)
         if plan.keeps_filtered and not return_maps:
             if engine is not None:
                 engine.last_plan = plan

@@ -11,7 +11,10 @@ import pytest
 from PIL import Image
 
 from aarecovery.colour import REC601_LUMA, largest_channel
+from aarecovery.params import SIGMA_D, SIGMA_E
 from aarecovery.plan import compression, pointwise
+from aarecovery.spec import to_working_space
+from aarecovery.spec.blend_model import fit_paper_model
 
 from jpeg_scans import scan_page
 
@@ -74,3 +77,19 @@ def test_the_scaled_luma_is_that_of_the_direct_formulas():
     for a, b in zip(fast, direct):
         np.testing.assert_array_equal(a, b)
     assert 0 < direct[1].mean() < 1 and (source_luma <= 1e-6).any()
+
+
+def test_a_model_fitted_on_some_pixels_is_the_whole_fit_there():
+    rng = np.random.default_rng(5)
+    blocks = (rng.random((40, 40, 3)) > 0.5).astype(np.float32).repeat(4, 0).repeat(4, 1)
+    encoded = (blocks[:-1, :-1] + blocks[1:, :-1] + blocks[:-1, 1:] + blocks[1:, 1:]) / 4
+    noisy = np.clip(encoded + rng.normal(0, 0.01, encoded.shape), 0, 1).astype(np.float32)
+    work = to_working_space(np.concatenate([noisy, np.ones(noisy.shape[:2] + (1,), np.float32)], -1))
+    only = np.zeros(work.shape[:2], bool)
+    only[1::3] = True
+    whole = fit_paper_model(work, work, SIGMA_D.default, SIGMA_E.default)
+    some = fit_paper_model(work, work, SIGMA_D.default, SIGMA_E.default, only=only)
+    assert (whole.beta[only] > 0.5).any()
+    for name in ("alpha", "beta", "index_a", "index_b", "residual"):
+        np.testing.assert_array_equal(getattr(some, name)[only], getattr(whole, name)[only])
+    assert not some.beta[~only].any() and (some.alpha[~only] == 0.5).all()

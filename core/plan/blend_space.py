@@ -10,7 +10,8 @@ right for cameras.
 import numpy as np
 
 from ..params import BLEND_SPACES, SIGMA_D, SIGMA_E
-from ..spec import fit_blend_model, to_working_space
+from ..spec import to_working_space
+from ..spec.blend_model import fit_paper_model
 from ..spec.neighbourhood import neighbours, planes
 
 __all__ = ["choose_blend_space", "colour_line_residual", "sampled_rows"]
@@ -59,13 +60,16 @@ def colour_line_residual(rgba, linear_input, blend_space):
         None where fewer than 16 such pixels were found.
     """
     work, middle = sampled_rows(to_working_space(rgba, linear_input=linear_input, blend_space=blend_space))
-    model = fit_blend_model(work, work, SIGMA_D.default, SIGMA_E.default)
+    middle_rows = np.zeros(work.shape[:2], bool)
+    middle_rows[middle] = True
+    # Only the middle rows are read: fitting the strips' outer rows too took 2/3 of the time.
+    model = fit_paper_model(work, work, SIGMA_D.default, SIGMA_E.default, only=middle_rows)
     colours = np.stack(neighbours(planes(work)))
     c_a = np.take_along_axis(colours, model.index_a[None, None].astype(np.intp), 0)[0]
     c_b = np.take_along_axis(colours, model.index_b[None, None].astype(np.intp), 0)[0]
     span = np.sqrt(np.sum(np.square(c_a - c_b)[:3], axis=0))
     selected = (model.beta > 0.5) & (span > 0.2) & (model.alpha > 0.03) & (model.alpha < 0.97)
-    selected[~np.isin(np.arange(work.shape[0]), np.arange(work.shape[0])[middle])] = False
+    selected &= middle_rows
     if selected.sum() < 16:
         return None
     return float(np.mean(model.residual[selected] / span[selected]))

@@ -214,7 +214,7 @@ def confidence(residual, edge, sigma_d, sigma_e, strength):
     return beta.astype(np.float32)
 
 
-def fit_paper_model(original, filtered, sigma_d, sigma_e, strength=1.0):
+def fit_paper_model(original, filtered, sigma_d, sigma_e, strength=1.0, only=None):
     """The paper's model at every pixel of O: extremes, coverage, residual, confidence.
 
     Parameters
@@ -229,6 +229,10 @@ def fit_paper_model(original, filtered, sigma_d, sigma_e, strength=1.0):
     strength : float
         Multiplies the confidence ``beta`` (the safe default's per-image repair strength);
         1 is the paper's method and leaves ``beta`` bit-identical.
+    only : ndarray of bool, shape (H, W), optional
+        Fit these pixels only, the others keep the unfitted model (a caller that reads a
+        few rows, as the safe plan's blend-space test does); each fitted pixel's model is
+        the same, bit for bit, as without it.
 
     Returns
     -------
@@ -239,6 +243,8 @@ def fit_paper_model(original, filtered, sigma_d, sigma_e, strength=1.0):
     # Where e_p == 0 beta is exactly 0 and the model unused: fit only the other pixels (most
     # of a thresholded or posterized image is flat), as (4, N) columns.
     fitted = edge > 0
+    if only is not None:
+        fitted &= only
     alpha = np.full(edge.shape, 0.5, np.float32)
     beta = np.zeros(edge.shape, np.float32)
     residual = np.zeros(edge.shape, np.float32)
