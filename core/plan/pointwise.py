@@ -112,14 +112,17 @@ def fit_pointwise(original, filtered, edges):
         transfer.mean_miss = float(miss.mean())
         return float((miss <= _LUT_TOLERANCE).mean())
 
+    # F's channels as the weights bincount converts them to, once for every key.
+    weights = [filtered[..., c].ravel().astype(np.float64) for c in range(3)]
     for key in TABLE_KEYS:
         values = key_of(original, key)
         index = _bins(values)
         table = np.empty((_LUT_BINS, 3), np.float32)
+        shared_counts = None if key == "channel" else np.bincount(index.ravel(), minlength=_LUT_BINS)
         for c in range(3):
             bins = index[..., c] if key == "channel" else index
-            sums = np.bincount(bins.ravel(), filtered[..., c].ravel(), minlength=_LUT_BINS)
-            counts = np.bincount(bins.ravel(), minlength=_LUT_BINS)
+            sums = np.bincount(bins.ravel(), weights[c], minlength=_LUT_BINS)
+            counts = np.bincount(bins.ravel(), minlength=_LUT_BINS) if shared_counts is None else shared_counts
             filled = counts > 0
             centres = np.arange(_LUT_BINS)
             table[:, c] = np.interp(centres, centres[filled], sums[filled] / counts[filled]) if filled.any() else 0
