@@ -385,7 +385,8 @@ class GLBackend:
         defines = {"LOCAL_ENCODE": int(self._linear["original"])}
         steps = (({"original_image": self._textures["original"]}, "local_flat"),
                  ({"local_input": self._work("local_flat")}, "local_rows"),
-                 ({"local_input": self._work("local_rows")}, "strength_factor"))
+                 ({"local_input": self._work("local_rows"), "original_image": self._textures["original"]},
+                  "strength_factor"))
         for number, (inputs, output) in enumerate(steps, 1):
             self._path.run_pass("local_plan", inputs, [self._work(output)], uniforms={"textured": local.textured},
                                 defines={**defines, "LOCAL_PASS": number})
