@@ -9,12 +9,12 @@ const float FLAT_SPAN = 0.5 / 255.0;
 const int REGION_RADIUS = 8;
 const float TEXTURED_SHARE = 0.1;
 const float HARD_EDGED_SHARE = 0.3;
-const int INK_RADIUS = 2;
+const int INK_RADIUS = 3;
 const int INK_REPEATS = 3;
 const float INK_NEAR_SPAN = 3.5 / 255.0;
 const float INK_DARK = 5.0 / 255.0;
-const float INK_SHARE_LOW = 0.4;
-const float INK_SHARE_HIGH = 0.8;
+const float INK_SHARE_LOW = 0.3;
+const float INK_SHARE_HIGH = 0.7;
 
 uniform sampler2D original_image;  // O as uploaded (passes 1 and 3)
 uniform sampler2D local_input;     // the previous pass's output (passes 2 and 3)
@@ -29,8 +29,8 @@ vec3 original_encoded(ivec2 p, ivec2 size) {
 }
 
 // 1 where the pixel holds drawn ink: an extreme of its 3 x 3 neighbourhood whose colour
-// recurs exactly in the 5 x 5 square (its part inside the image), with few colours a few levels from it, and not near
-// black; smooth in the pixel's share of that ink.
+// recurs exactly in the 7 x 7 square (its part inside the image), with few colours a few
+// levels from it, and not near black; smooth in the pixel's share of that ink.
 float ink_weight(ivec2 p, ivec2 size) {
     vec3 brightest = vec3(0.0);
     vec3 darkest = vec3(0.0);
