@@ -169,6 +169,16 @@ def _caption_on_photo(filter_name, k=4, size=96):
     return make_case(np.asarray(scene, np.float32) / np.float32(255), filter_name, k, "linear"), caption
 
 
+@pytest.mark.filterwarnings("ignore::aarecovery.errors.TileSizeWarning")
+def test_drawn_ink_is_the_same_tiled_and_untiled():
+    case, _ = _caption_on_photo("threshold")
+    whole = aarecovery.recover(case.original, case.filtered, backend="numpy")
+    assert local_plan.ink_weight(case.original).max() == 1
+    for tile in (24, 40):
+        np.testing.assert_array_equal(aarecovery.recover(case.original, case.filtered, backend="numpy",
+                                                         tile_size=tile), whole)
+
+
 @pytest.mark.parametrize("filter_name", ["threshold", "posterize"])
 def test_drawn_ink_repairs_a_caption_on_the_photo_and_leaves_the_photo_alone(filter_name, gl_path, monkeypatch):
     """Strokes a pixel or two wide have no flat neighbourhood; their exactly recurring ink
