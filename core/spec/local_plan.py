@@ -136,29 +136,63 @@ def ink_weight(encoded):
     encoded : ndarray of float32, shape (H, W, 3)
         O's sRGB-encoded colour (borders replicated).
     """
-    encoded = np.ascontiguousarray(encoded, np.float32)
-    neighbours = np.stack(_shifted(encoded, 1))
-    brightness = neighbours[..., 0] + neighbours[..., 1] + neighbours[..., 2]
-    extremes = [np.take_along_axis(neighbours, pick(brightness, axis=0)[None, ..., None], 0)[0]
-                for pick in (np.argmax, np.argmin)]
-    # The outside is not there (NaN is equal and near to nothing): replicated borders would
-    # repeat every border pixel's colour.
-    square = _shifted(encoded, INK_RADIUS, outside=np.nan)
-    weight = np.zeros(encoded.shape[:2], np.float32)
-    for ink, other in (extremes, extremes[::-1]):
-        equal = np.zeros(encoded.shape[:2], np.int32)
-        near = np.zeros(encoded.shape[:2], np.int32)
-        for colour in square:
-            distance = np.abs(colour - ink).max(axis=-1)
-            equal += distance <= np.float32(FLAT_SPAN)
-            near += (distance > np.float32(FLAT_SPAN)) & (distance <= np.float32(INK_NEAR_SPAN))
-        drawn = (equal >= INK_REPEATS) & (2 * near <= equal) & (ink.max(axis=-1) > np.float32(INK_DARK))
-        span = np.sqrt(np.square(other - ink).sum(axis=-1, dtype=np.float32))
-        distance = np.sqrt(np.square(encoded - ink).sum(axis=-1, dtype=np.float32))
+    planes = np.ascontiguousarray(np.moveaxis(np.asarray(encoded, np.float32), -1, 0))
+    extremes = _extremes(planes)
+    weight = np.zeros(planes.shape[1:], np.float32)
+    for (ink, other), (equal, near) in zip((extremes, extremes[::-1]), _recurrences(planes, extremes)):
+        drawn = (equal >= INK_REPEATS) & (2 * near <= equal) & (ink.max(axis=0) > np.float32(INK_DARK))
+        span = np.sqrt(np.square(other - ink).sum(axis=0, dtype=np.float32))
+        distance = np.sqrt(np.square(planes - ink).sum(axis=0, dtype=np.float32))
         share = np.where(span > 0, np.float32(1) - distance / np.where(span > 0, span, np.float32(1)), np.float32(0))
         rise = _smoothstep((share - np.float32(INK_SHARE_LOW)) / np.float32(INK_SHARE_HIGH - INK_SHARE_LOW))
         weight = np.maximum(weight, np.where(drawn, rise, np.float32(0)))
-    return weight.astype(np.float32)
+    return weight
+
+
+def _extremes(planes):
+    """The brightest and darkest colour ``(3, H, W)`` of each 3 x 3 neighbourhood (borders
+    replicated), by the sum of the channels, the first in row order on ties."""
+    brightest, darkest = None, None
+    for colour in _shifted(np.moveaxis(planes, 0, -1), 1):
+        colour = np.moveaxis(colour, -1, 0)
+        brightness = colour[0] + colour[1] + colour[2]
+        if brightest is None:
+            brightest, darkest = colour.copy(), colour.copy()
+            high, low = brightness, brightness.copy()
+            continue
+        higher, lower = brightness > high, brightness < low
+        np.copyto(brightest, colour, where=higher)
+        np.copyto(darkest, colour, where=lower)
+        np.maximum(high, brightness, out=high)
+        np.minimum(low, brightness, out=low)
+    return brightest, darkest
+
+
+def _recurrences(planes, extremes):
+    """Per extreme: how many pixels of the square of :data:`INK_RADIUS` (inside the image)
+    equal it within :data:`FLAT_SPAN`, and how many lie farther but within :data:`INK_NEAR_SPAN`."""
+    radius = INK_RADIUS
+    height, width = planes.shape[1:]
+    # The outside is not there (NaN is equal and near to nothing): replicated borders would
+    # repeat every border pixel's colour.
+    padded = np.pad(planes, ((0, 0), (radius, radius), (radius, radius)), constant_values=np.nan)
+    counts = [(np.zeros((height, width), np.int32), np.zeros((height, width), np.int32)) for _ in extremes]
+    difference = np.empty((height, width), np.float32)
+    distance = np.empty((height, width), np.float32)
+    for dy in range(2 * radius + 1):
+        for dx in range(2 * radius + 1):
+            colour = padded[:, dy:dy + height, dx:dx + width]
+            for ink, (equal, near) in zip(extremes, counts):
+                np.subtract(colour[0], ink[0], out=distance)
+                np.abs(distance, out=distance)
+                for channel in (1, 2):
+                    np.subtract(colour[channel], ink[channel], out=difference)
+                    np.abs(difference, out=difference)
+                    np.maximum(distance, difference, out=distance)
+                same = distance <= np.float32(FLAT_SPAN)
+                equal += same
+                near += ~same & (distance <= np.float32(INK_NEAR_SPAN))
+    return counts
 
 
 def _box_sum(mask, radius):
