@@ -24,8 +24,10 @@ runs the same passes on each tile: 1, 2 and the sums of 3 along rows, then along
    :data:`HARD_EDGED_SHARE`, a smoothstep between: box sums change by at most one pixel's
    worth from one pixel to the next, so the weight has no step and R no seam where the
    decision changes.
-4. :meth:`LocalStrength.factor`: the factor of the confidence ``beta``, from the textured
-   strength (photo regions) to 1 (hard-edged regions).
+4. :func:`ink_weight`: per pixel, how much drawn ink it holds (below; the GL twin computes
+   it in pass 3, from O).
+5. :meth:`LocalStrength.factor`: the factor of the confidence ``beta``, from the textured
+   strength (photo regions) to 1 (hard-edged regions or drawn ink), by the larger weight.
 
 Thresholds chosen on the tuning half of the mixed scenes (shares 0.05-0.25, 0.1-0.3 and
 0.15-0.35, radii 6, 8 and 16: graphics 0.596-0.609, photo 0.360-0.367 of the edge error
