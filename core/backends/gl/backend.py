@@ -394,7 +394,8 @@ class GLBackend:
         defines = {"LOCAL_ENCODE": int(self._linear["original"])}
         steps = (({"original_image": self._textures["original"]}, "local_flat", "dilated"),
                  ({"local_input": self._work("local_flat")}, "local_rows", "dilated"),
-                 ({"local_input": self._work("local_rows")}, "strength_factor", "active"))
+                 ({"local_input": self._work("local_rows"), "original_image": self._textures["original"]},
+                  "strength_factor", "active"))
         for number, (inputs, output, list_name) in enumerate(steps, 1):
             where = {} if blocks is None else {"blocks": blocks[0], "list_name": list_name}
             self._path.run_pass("local_plan", inputs, [self._work(output)], uniforms={"textured": local.textured},

@@ -1,17 +1,77 @@
 // The local plan's factor of beta, in three passes over the whole image, each reading the
 // last (LOCAL_PASS 1, 2, 3): O's flat pixels, their sums along rows, then the sums along
-// columns, the region's flat share and the factor. Twin: flat_pixels, flat_share,
-// hard_edged_weight and LocalStrength.factor in aarecovery/spec/local_plan.py. With
+// columns, the region's flat share, the pixel's drawn ink (read from O) and the factor.
+// Twin: flat_pixels, flat_share, hard_edged_weight, ink_weight and LocalStrength.factor in
+// aarecovery/spec/local_plan.py. With
 // LOCAL_ENCODE the uploaded O is linear light and is sRGB-encoded first. Needs colour.glsl.
 
 const float FLAT_SPAN = 0.5 / 255.0;
 const int REGION_RADIUS = 8;
 const float TEXTURED_SHARE = 0.1;
 const float HARD_EDGED_SHARE = 0.3;
+const int INK_RADIUS = 3;
+const int INK_REPEATS = 3;
+const float INK_NEAR_SPAN = 3.5 / 255.0;
+const float INK_DARK = 5.0 / 255.0;
+const float INK_SHARE_LOW = 0.3;
+const float INK_SHARE_HIGH = 0.7;
 
-uniform sampler2D original_image;  // O as uploaded (pass 1)
+uniform sampler2D original_image;  // O as uploaded (passes 1 and 3)
 uniform sampler2D local_input;     // the previous pass's output (passes 2 and 3)
 uniform float textured;            // the factor in textured regions (pass 3)
+
+vec3 original_encoded(ivec2 p, ivec2 size) {
+    vec3 c = texelFetch(original_image, clamp(p, ivec2(0), size - 1), 0).rgb;
+#if LOCAL_ENCODE
+    c = linear_to_srgb(c);
+#endif
+    return c;
+}
+
+// 1 where the pixel holds drawn ink: an extreme of its 3 x 3 neighbourhood whose colour
+// recurs exactly in the 7 x 7 square (its part inside the image), with few colours a few
+// levels from it, and not near black; smooth in the pixel's share of that ink.
+float ink_weight(ivec2 p, ivec2 size) {
+    vec3 brightest = vec3(0.0);
+    vec3 darkest = vec3(0.0);
+    float high = -1.0;
+    float low = 4.0;
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            vec3 c = original_encoded(p + ivec2(dx, dy), size);
+            float b = c.r + c.g + c.b;
+            if (b > high) { high = b; brightest = c; }
+            if (b < low) { low = b; darkest = c; }
+        }
+    }
+    vec3 centre = original_encoded(p, size);
+    float weight = 0.0;
+    for (int side = 0; side < 2; ++side) {
+        vec3 ink = side == 0 ? brightest : darkest;
+        vec3 other = side == 0 ? darkest : brightest;
+        int equal = 0;
+        int near = 0;
+        for (int dy = -INK_RADIUS; dy <= INK_RADIUS; ++dy) {
+            for (int dx = -INK_RADIUS; dx <= INK_RADIUS; ++dx) {
+                ivec2 q = p + ivec2(dx, dy);
+                if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;  // not there
+                vec3 d = abs(original_encoded(q, size) - ink);
+                float distance = max(d.r, max(d.g, d.b));
+                if (distance <= FLAT_SPAN) equal += 1;
+                else if (distance <= INK_NEAR_SPAN) near += 1;
+            }
+        }
+        bool drawn = equal >= INK_REPEATS && 2 * near <= equal && max(ink.r, max(ink.g, ink.b)) > INK_DARK;
+        vec3 across = other - ink;
+        vec3 from_ink = centre - ink;
+        float span = sqrt(across.r * across.r + across.g * across.g + across.b * across.b);
+        float share = span > 0.0 ? 1.0 - sqrt(from_ink.r * from_ink.r + from_ink.g * from_ink.g
+                                              + from_ink.b * from_ink.b) / span : 0.0;
+        float t = clamp((share - INK_SHARE_LOW) / (INK_SHARE_HIGH - INK_SHARE_LOW), 0.0, 1.0);
+        if (drawn) weight = max(weight, t * t * (3.0 - 2.0 * t));
+    }
+    return weight;
+}
 
 float local_plan(ivec2 p, ivec2 size) {
 #if LOCAL_PASS == 1
@@ -21,10 +81,7 @@ float local_plan(ivec2 p, ivec2 size) {
     vec3 brightest = vec3(-1.0);
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
-            vec3 c = texelFetch(original_image, clamp(p + ivec2(dx, dy), ivec2(0), size - 1), 0).rgb;
-#if LOCAL_ENCODE
-            c = linear_to_srgb(c);
-#endif
+            vec3 c = original_encoded(p + ivec2(dx, dy), size);
             lowest = min(lowest, c);
             brightest = max(brightest, c);
         }
@@ -51,7 +108,7 @@ float local_plan(ivec2 p, ivec2 size) {
     ivec2 high = min(p + REGION_RADIUS, size - 1);
     float inside = float((high.x - low.x + 1) * (high.y - low.y + 1));
     float t = clamp((count / inside - TEXTURED_SHARE) / (HARD_EDGED_SHARE - TEXTURED_SHARE), 0.0, 1.0);
-    float weight = t * t * (3.0 - 2.0 * t);
+    float weight = max(t * t * (3.0 - 2.0 * t), ink_weight(p, size));
     return textured + (1.0 - textured) * weight;
 #endif
 }
