@@ -72,3 +72,11 @@ def test_the_numpy_yardstick_is_the_papers_method():
 def test_bench_refuses_an_unknown_configuration(capsys):
     assert main(["bench", "--configs", "gl-vulkan"]) == 1
     assert "unknown configuration 'gl-vulkan'" in capsys.readouterr().err
+
+
+def test_bench_process_without_numpy_runs_leaves_the_numpy_program_out(capsys):
+    status = main(["bench", "--process", "64", "--runs", "1", "--pairs", "photo", "--numpy-runs", "0", "--json"])
+    assert status == 0
+    (pair,) = json.loads(capsys.readouterr().out)["process"]["pairs"]
+    assert "numpy-paper" not in pair["rows"] and "numpy-paper/safe" not in pair["ratios"]
+    assert {"safe", "paper"} <= set(pair["rows"]) and "safe/paper" in pair["ratios"]

@@ -110,7 +110,8 @@ def register(subparsers):
                         help="with --process: thin (thin features, pure colours) and/or photo (photo-like), "
                              "default %(default)s")
     parser.add_argument("--numpy-runs", type=int, default=1,
-                        help="with --process: runs of the NumPy program, at most --runs (default %(default)s)")
+                        help="with --process: runs of the NumPy program, at most --runs; 0 leaves it out "
+                             "(default %(default)s)")
     parser.add_argument("--batch", metavar="N", type=int, nargs="?", const=100,
                         help="instead: N pairs of 1920x1080 PNGs through one 'aarecovery batch' (with 1 to 4 "
                              "workers) against N separate 'aarecovery recover' calls, in images per second "

@@ -111,6 +111,8 @@ def _time_pair(name, width, height, runs, numpy_runs, folder, log):
     write_image(paths[1], filtered)
     del original, filtered
     lines = _command_lines(*paths)
+    if numpy_runs <= 0:
+        del lines["numpy-paper"]
     measured = {command: [] for command in lines}
     load_before = _load()
     for run in range(runs):
@@ -149,7 +151,7 @@ def bench_processes(width, height, runs, *, numpy_runs=1, pairs=tuple(PAIRS), lo
     runs : int
         Runs of each command, in turn.
     numpy_runs : int
-        Runs of the NumPy program (at most `runs`).
+        Runs of the NumPy program (at most `runs`); 0 leaves it out.
     pairs : sequence of str
         Keys of :data:`PAIRS`.
     log : callable
