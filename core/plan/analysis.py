@@ -37,7 +37,8 @@ colour lines better), then takes the first of these exits that applies, each nam
 10. ``NEIGHBOURHOOD_HARD_EDGED``: a neighbourhood filter on hard-edged content: the paper's
     passes at full strength and, where the filter keeps flat colours (sharpening,
     edge-aware smoothing), the pure colours of thin features with the identity as the
-    table (``flat_colours``).
+    table (``flat_colours``); on hatched or screentoned content under a smoothing filter
+    (``hatching``) only in its flat regions, F kept in the hatched ones (the local plan).
 
 In a compressed O, texture is read in the blocks of its grid that hold no edge
 (``texture``), so that compression noise is neither texture nor edge.
@@ -60,6 +61,7 @@ from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
 from .compression import COMPRESSED_REPAIR_TO_ERROR, compression_evidence
 from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
+from .hatching import HATCHED_SHARE, SMOOTHED_CONTRAST, contrast_ratio, hatched_share
 from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
@@ -259,10 +261,17 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # Filters that keep flat colours (sharpening, edge-aware smoothing): thin features get
     # their pure colours with the identity as the table (plan/flat_colours.py).
     prior, kept = flat_colour_prior(o, f, edges)
-    return PairAnalysis(space, 1.0, f"neighbourhood filter on hard-edged content (repair-to-error ratio "
-                                    f"{ratio:.1f}): full strength"
-                                    + (f", pure colours of thin features ({kept})" if prior is not None else ""),
-                        Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
+    why = (f"neighbourhood filter on hard-edged content (repair-to-error ratio {ratio:.1f}): full strength"
+           + (f", pure colours of thin features ({kept})" if prior is not None else ""))
+    # Hatching and screentone are texture, not edges to blend, for a filter that smooths them
+    # (plan/hatching.py): on a hatched O only the flat regions are repaired, F is kept in the
+    # hatched ones (the local plan with a textured strength of 0).
+    hatched = hatched_share(o, edges)
+    if hatched >= HATCHED_SHARE and contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST:
+        return PairAnalysis(space, 1.0, why + f" in flat regions; hatching or screentone around {hatched:.2f} of "
+                                              "the edges: F kept there", Decision.NEIGHBOURHOOD_HARD_EDGED, prior,
+                            local=LocalStrength(0.0))
+    return PairAnalysis(space, 1.0, why, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
 
 
 def _is_grey(encoded):

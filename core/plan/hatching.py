@@ -1,0 +1,120 @@
+"""Hatching and screentone: texture that a neighbourhood filter must not see as edges to blend.
+
+Hatching (parallel thin strokes a few pixels apart) and screentone (a grid of dots) alternate
+between two colours every few pixels. To the paper's model every stroke is an antialiased
+edge, but an edge-aware filter (a bilateral filter, OpenCV's edge-preserving smoothing)
+averages across the strokes, and the reference (the scene filtered at a higher resolution)
+keeps more of them than F does: the model's blend of O's extreme colours there moves R away
+from both. Measured on the tuning half's screentone manga taken through the hard-edged
+branch at full strength: OpenCV's bilateral filter lost 0.61 dB against F (linear light).
+
+The evidence is how densely O's luma alternates: a pixel is a **stroke extremum** when it is
+brighter or darker than both of its neighbours along a row or a column by
+:data:`_EXTREMUM_CONTRAST`; hatching and screentone put one every two or three pixels, a
+drawing's lines one per line. Where a share :data:`HATCHED_SHARE` of O's edge pixels lie in
+squares dense with extrema, the image is hatched, and where F smooths it (its Laplacian
+at O's edges is lower than :data:`SMOOTHED_CONTRAST` times O's) the plan repairs only its flat regions
+(the local plan of ``aarecovery.spec.local_plan`` with F kept where O has no flat pixels: the
+hatched and dotted regions have none), with its GL twin.
+
+Tuning half, drawings under the bilateral and edge-preserving filters (the 11 x 11 square,
+extrema 16/255 apart): the shares are 0.16-0.33 on serif text and maps, 0.50-0.58 on the
+star burst's converging rays and 0.70-0.80 on the screentone manga.
+"""
+
+import numpy as np
+
+from ..colour import LUMA_WEIGHTS
+
+__all__ = ["hatched_share", "contrast_ratio", "HATCHED_SHARE", "DENSE_EXTREMA", "SMOOTHED_CONTRAST"]
+
+# A stroke extremum differs from both neighbours along a row or a column by more than this
+# (encoded luma): an antialiased stroke's core against the paper, not 8-bit noise or JPEG ringing.
+_EXTREMUM_CONTRAST = 16.0 / 255
+# The square around an edge pixel in which extrema are counted: 11 x 11 pixels, a few periods
+# of hatching at the suite's scales.
+_DENSITY_RADIUS = 5
+#: A square is dense with strokes when this share of its pixels are stroke extrema (hatching
+#: two or three pixels apart puts 0.3-0.5 there, a lone line's square about 0.1-0.2).
+DENSE_EXTREMA = 0.3
+#: O is hatched when this share of its edge pixels lie in dense squares (tuning half: 0.58 at
+#: most on drawings without screentone, 0.70 at least on the screentone manga).
+HATCHED_SHARE = 0.65
+#: F smooths (rather than sharpens) when its Laplacian at O's edges is below this multiple of
+#: O's. Only smoothing averages the strokes away: under an unsharp mask the screentone manga
+#: (tuning half) gained 0.60-0.74 of its edge error at full strength everywhere and 0.10-0.13
+#: with F kept in its hatched regions. Tuning half, drawings: bilateral and edge-preserving
+#: filters 0.78-1.00, unsharp masks 1.42-2.37.
+SMOOTHED_CONTRAST = 1.2
+
+
+def _stroke_extrema(encoded):
+    luma = encoded @ LUMA_WEIGHTS.astype(np.float32)
+    padded = np.pad(luma, 1, mode="edge")
+    left, right = padded[1:-1, :-2], padded[1:-1, 2:]
+    up, down = padded[:-2, 1:-1], padded[2:, 1:-1]
+    c = np.float32(_EXTREMUM_CONTRAST)
+
+    def peak(a, b):
+        return ((luma - a > c) & (luma - b > c)) | ((a - luma > c) & (b - luma > c))
+
+    return peak(left, right) | peak(up, down)
+
+
+def _box_mean(mask, radius):
+    """Mean of `mask` over the square of `radius` around each pixel (the outside not counted)."""
+    def box_sum(values):
+        padded = np.pad(values.astype(np.float64), ((radius + 1, radius), (radius + 1, radius)))
+        table = padded.cumsum(axis=0).cumsum(axis=1)
+        side = 2 * radius + 1
+        height, width = values.shape
+        return (table[side:side + height, side:side + width] - table[:height, side:side + width]
+                - table[side:side + height, :width] + table[:height, :width])
+    return box_sum(mask) / box_sum(np.ones(mask.shape, bool))
+
+
+def _laplacian(encoded):
+    luma = encoded @ LUMA_WEIGHTS.astype(np.float32)
+    padded = np.pad(luma, 1, mode="edge")
+    return np.abs(4 * luma - padded[:-2, 1:-1] - padded[2:, 1:-1] - padded[1:-1, :-2] - padded[1:-1, 2:])
+
+
+def contrast_ratio(original, filtered, edges):
+    """F's mean absolute Laplacian (of luma) at O's edge pixels over O's: below 1 F smooths.
+
+    Parameters
+    ----------
+    original, filtered : ndarray of float32, shape (H, W, 3)
+        Encoded colour (the analysis crop).
+    edges : ndarray of bool, shape (H, W)
+
+    Returns
+    -------
+    float
+        1 without edge pixels or where O's Laplacian is 0 there.
+    """
+    contrast = _laplacian(original)[edges].sum() if edges.any() else 0.0
+    if contrast <= 0:
+        return 1.0
+    return float(_laplacian(filtered)[edges].sum() / contrast)
+
+
+def hatched_share(encoded, edges):
+    """Share of O's edge pixels that lie in squares dense with stroke extrema.
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (H, W, 3)
+        O's sRGB-encoded colour (the analysis crop).
+    edges : ndarray of bool, shape (H, W)
+        O's edge pixels.
+
+    Returns
+    -------
+    float
+        In [0, 1]; 0 without edge pixels.
+    """
+    if not edges.any():
+        return 0.0
+    density = _box_mean(_stroke_extrema(encoded), _DENSITY_RADIUS)
+    return float((density[edges] > DENSE_EXTREMA).mean())
