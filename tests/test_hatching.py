@@ -14,8 +14,9 @@ from aarecovery import Decision
 from aarecovery.lab import scenes as _scenes
 from aarecovery.lab.groundtruth import make_case
 from aarecovery.lab.metrics import edge_band, error_reduction
+from aarecovery.lab.realtools import render_family
 from aarecovery.plan.calibration import EDGE_GRADIENT
-from aarecovery.plan.hatching import HATCHED_SHARE, hatched_share
+from aarecovery.plan.hatching import HATCHED_SHARE, hatched_share, is_screentone_drawing
 from aarecovery.spec.sobel import gradient_magnitude
 
 _K = 4
@@ -73,6 +74,8 @@ def test_a_hatched_drawing_is_repaired_only_in_its_flat_regions(hatched_case):
     assert maps.strength[8:40, 8:40].max() == 0 and maps.strength[8:40, 56:88].max() == 0
     assert maps.strength[68:80, 64:80].min() == 1
     assert error_reduction(result, f, reference, band) >= 0
+    summary = aarecovery.summarize_recovery(plan, o, f, result)
+    assert f"hatching and screentone {1 - summary.hard_edged_share:.0%} at 0" in summary.line()
 
 
 def test_a_sharpened_hatched_drawing_is_repaired_everywhere():
@@ -95,3 +98,17 @@ def test_gl_keeps_f_in_the_hatching_as_numpy_does(hatched_case, gl_path):
     np.testing.assert_allclose(gl_maps.strength, numpy_maps.strength, atol=1e-6)
     assert numpy_maps.strength.min() == 0 and numpy_maps.strength.max() == 1
     np.testing.assert_allclose(gl_result, numpy_result, atol=1e-5)
+
+
+def test_a_screentone_comic_is_a_drawing_and_a_photo_is_not():
+    """The manga's screentone reads as grain (a photo's, to the texture test); its flat paper and
+    dense dots make it a drawing, which the neighbourhood branch repairs."""
+    manga = make_case(render_family("manga", 64), "unsharp", 8, "srgb")
+    photo = make_case(_scenes.render("astronaut", 64, _K), "unsharp", _K, "linear")
+    assert is_screentone_drawing(manga.original, _edges(manga.original))
+    assert not is_screentone_drawing(photo.original, _edges(photo.original))
+    with aarecovery.Engine("numpy") as engine:
+        result = aarecovery.recover(manga.original, manga.filtered, engine=engine)
+        assert engine.last_plan.decision == Decision.NEIGHBOURHOOD_HARD_EDGED, engine.last_plan.reason
+    band = edge_band(manga.original, manga.filtered, manga.reference)
+    assert error_reduction(result, manga.filtered, manga.reference, band) > 0.2

@@ -24,7 +24,8 @@ colour lines better), then takes the first of these exits that applies, each nam
    read as textured, and full strength in those that read as hard-edged (text, logos and
    lines drawn over the photo): the local plan (``aarecovery.spec.local_plan``), which the
    backends apply per tile.
-6. ``NEIGHBOURHOOD_TEXTURED_KEPT``: any other filter on a textured image that is not a
+6. ``NEIGHBOURHOOD_TEXTURED_KEPT``: any other filter on a textured image (but a comic's
+   screentone, whose dots read as grain: ``hatching``) that is not a
    colour map of all three channels at once (``colour_map``): it cannot be simulated and
    the model would flatten the texture, F is kept.
 7. ``COLOUR_MAP_KEPT``: a colour map on a textured image whose repairs are no larger than
@@ -61,7 +62,7 @@ from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
 from .compression import COMPRESSED_REPAIR_TO_ERROR, compression_evidence
 from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
-from .hatching import HATCHED_SHARE, SMOOTHED_CONTRAST, contrast_ratio, hatched_share
+from .hatching import HATCHED_SHARE, SMOOTHED_CONTRAST, contrast_ratio, hatched_share, is_screentone_drawing
 from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
@@ -226,8 +227,12 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # found none (strength 0), F is kept everywhere, as before.
         return PairAnalysis(space, 1.0, why + " for textured regions, full strength for hard-edged ones",
                             Decision.POINTWISE_CALIBRATED, local=LocalStrength(strength))
+    colour_map = fit_colour_map(o, f, edges) if textured else None
+    # A comic's screentone reads as texture, but it is a drawing (plan/hatching.py): under a
+    # neighbourhood filter that is no colour map it goes on to the hard-edged branch below.
+    if textured and colour_map.consistency < COLOUR_MAP_SHARE and is_screentone_drawing(o, edges):
+        textured = False
     if textured:
-        colour_map = fit_colour_map(o, f, edges)
         if colour_map.consistency < COLOUR_MAP_SHARE:
             return PairAnalysis(space, _PHOTO_NEIGHBOURHOOD_STRENGTH,
                                 f"neighbourhood filter on a textured image ({texture}): "
@@ -270,7 +275,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     if hatched >= HATCHED_SHARE and contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST:
         return PairAnalysis(space, 1.0, why + f" in flat regions; hatching or screentone around {hatched:.2f} of "
                                               "the edges: F kept there", Decision.NEIGHBOURHOOD_HARD_EDGED, prior,
-                            local=LocalStrength(0.0))
+                            local=LocalStrength(0.0, "hatching and screentone"))
     return PairAnalysis(space, 1.0, why, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
 
 

@@ -12,21 +12,31 @@ The evidence is how densely O's luma alternates: a pixel is a **stroke extremum*
 brighter or darker than both of its neighbours along a row or a column by
 :data:`_EXTREMUM_CONTRAST`; hatching and screentone put one every two or three pixels, a
 drawing's lines one per line. Where a share :data:`HATCHED_SHARE` of O's edge pixels lie in
-squares dense with extrema, the image is hatched, and where F smooths it (its Laplacian
-at O's edges is lower than :data:`SMOOTHED_CONTRAST` times O's) the plan repairs only its flat regions
-(the local plan of ``aarecovery.spec.local_plan`` with F kept where O has no flat pixels: the
-hatched and dotted regions have none), with its GL twin.
+squares dense with extrema, O is hatched, and it is used twice:
 
-Tuning half, drawings under the bilateral and edge-preserving filters (the 11 x 11 square,
-extrema 16/255 apart): the shares are 0.16-0.33 on serif text and maps, 0.50-0.58 on the
-star burst's converging rays and 0.70-0.80 on the screentone manga.
+* Where F smooths a hatched O (its Laplacian at O's edges is lower than
+  :data:`SMOOTHED_CONTRAST` times O's), the plan repairs only its flat regions: the local
+  plan of ``aarecovery.spec.local_plan`` (with its GL twin) with F kept where O has no flat
+  pixels, which the hatched and dotted regions have none of. A sharpening filter keeps the
+  strokes and is repaired everywhere.
+* A comic's screentone leaves few quiet pixels without dots, so that the texture test
+  (``texture``) reads it as a photo's grain and a neighbourhood filter kept F there. A
+  hatched O with flat paper (:func:`is_screentone_drawing`) is a drawing instead: photos
+  have almost no flat pixels and are hatched on few edges.
+
+Tuning half, drawings 96 pixels wide (the 11 x 11 square, extrema 16/255 apart): the shares
+are 0.16-0.33 on serif text and maps, 0.50-0.58 on the star burst's converging rays and
+0.70-0.80 on the screentone manga; photos and mixed scenes 0.00-0.19. At 64 pixels the maps
+and the star burst's rays are as dense as hatching (0.69-0.76).
 """
 
 import numpy as np
 
 from ..colour import LUMA_WEIGHTS
+from ..spec.local_plan import flat_pixels
 
-__all__ = ["hatched_share", "contrast_ratio", "HATCHED_SHARE", "DENSE_EXTREMA", "SMOOTHED_CONTRAST"]
+__all__ = ["hatched_share", "contrast_ratio", "HATCHED_SHARE", "DENSE_EXTREMA", "SMOOTHED_CONTRAST",
+           "is_screentone_drawing", "SCREENTONE_FLAT_SHARE"]
 
 # A stroke extremum differs from both neighbours along a row or a column by more than this
 # (encoded luma): an antialiased stroke's core against the paper, not 8-bit noise or JPEG ringing.
@@ -46,6 +56,12 @@ HATCHED_SHARE = 0.65
 #: with F kept in its hatched regions. Tuning half, drawings: bilateral and edge-preserving
 #: filters 0.78-1.00, unsharp masks 1.42-2.37.
 SMOOTHED_CONTRAST = 1.2
+#: A hatched O whose grain reads as a photo's (screentone dots leave few quiet pixels without
+#: them) is a drawing when at least this share of its pixels are flat (``spec.local_plan``:
+#: a 3 x 3 neighbourhood of one 8-bit colour, not black). Tuning half: the screentone manga
+#: 0.15 (0.04-0.05 from a JPEG), photos and mixed scenes 0.00-0.02 (a screenshot's chrome 0.08,
+#: but hatched on at most 0.16 of its edges, photos on at most 0.19).
+SCREENTONE_FLAT_SHARE = 0.03
 
 
 def _stroke_extrema(encoded):
@@ -97,6 +113,25 @@ def contrast_ratio(original, filtered, edges):
     if contrast <= 0:
         return 1.0
     return float(_laplacian(filtered)[edges].sum() / contrast)
+
+
+def is_screentone_drawing(encoded, edges):
+    """Whether a textured-looking O is a hatched drawing (screentone, hatching), not a photo:
+    :data:`HATCHED_SHARE` of its edge pixels are hatched and :data:`SCREENTONE_FLAT_SHARE`
+    of its pixels are flat.
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (H, W, 3)
+        O's sRGB-encoded colour (the analysis crop).
+    edges : ndarray of bool, shape (H, W)
+
+    Returns
+    -------
+    bool
+    """
+    return bool(hatched_share(encoded, edges) >= HATCHED_SHARE
+                and flat_pixels(encoded).mean() >= SCREENTONE_FLAT_SHARE)
 
 
 def hatched_share(encoded, edges):

@@ -106,10 +106,14 @@ class LocalStrength:
     Attributes
     ----------
     textured : float
-        The factor in textured regions (photos): the calibrated strength, in (0, 1).
+        The factor in textured regions: the calibrated strength for a photo, in (0, 1); 0
+        for hatching and screentone under a smoothing filter (``aarecovery.plan.hatching``).
+    textured_regions : str
+        What the textured regions are, for the summary line.
     """
 
     textured: float
+    textured_regions: str = "photo"
 
     #: How far the factor at a pixel reads O (a tile's extra halo).
     reach = REACH
