@@ -3,7 +3,8 @@
 A drawing whose shading is hatching (thin parallel strokes a few pixels apart) or screentone
 (a grid of dots) is smoothed by a bilateral filter. The paper's model reads every stroke as
 an antialiased edge and blends O's extremes there, which the filter averaged away; the safe
-default repairs only the flat regions of a hatched O and keeps F in the hatched ones.
+default repairs the flat regions of a hatched O at full strength and the hatched ones at a
+lower strength.
 """
 
 import numpy as np
@@ -16,7 +17,7 @@ from aarecovery.lab.groundtruth import make_case
 from aarecovery.lab.metrics import edge_band, error_reduction
 from aarecovery.lab.realtools import render_family
 from aarecovery.plan.calibration import EDGE_GRADIENT
-from aarecovery.plan.hatching import HATCHED_SHARE, hatched_share, is_screentone_drawing
+from aarecovery.plan.hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screentone_drawing
 from aarecovery.spec.sobel import gradient_magnitude
 
 _K = 4
@@ -65,17 +66,18 @@ def test_a_hatched_drawing_is_repaired_only_in_its_flat_regions(hatched_case):
         engine.set_images(hatched_case.original, hatched_case.filtered)
         plan = engine.plan()
         assert plan.decision == Decision.NEIGHBOURHOOD_HARD_EDGED, plan.reason
-        assert plan.local is not None and plan.local.textured == 0, plan.reason
+        assert plan.local is not None and plan.local.textured == HATCHED_STRENGTH, plan.reason
         engine.run(plan, maps=True)
         result, maps = engine.result(), engine.maps()
     o, f, reference = hatched_case.original, hatched_case.filtered, hatched_case.reference
     band = edge_band(o, f, reference)
-    # F is kept where O is hatched, the flat paper around the disc and frame is repaired.
-    assert maps.strength[8:40, 8:40].max() == 0 and maps.strength[8:40, 56:88].max() == 0
+    # The hatching is repaired at the lower strength, the flat paper around the disc and frame at full.
+    hatching, screentone = maps.strength[8:40, 8:40], maps.strength[8:40, 56:88]
+    assert hatching.max() == screentone.max() == np.float32(HATCHED_STRENGTH)
     assert maps.strength[68:80, 64:80].min() == 1
     assert error_reduction(result, f, reference, band) >= 0
     summary = aarecovery.summarize_recovery(plan, o, f, result)
-    assert f"hatching and screentone {1 - summary.hard_edged_share:.0%} at 0" in summary.line()
+    assert f"hatching and screentone {1 - summary.hard_edged_share:.0%} at {HATCHED_STRENGTH:g}" in summary.line()
 
 
 def test_a_sharpened_hatched_drawing_is_repaired_everywhere():
@@ -96,7 +98,7 @@ def test_gl_keeps_f_in_the_hatching_as_numpy_does(hatched_case, gl_path):
                                                   return_maps=True)
     (numpy_result, numpy_maps), (gl_result, gl_maps) = results["numpy"], results["gl"]
     np.testing.assert_allclose(gl_maps.strength, numpy_maps.strength, atol=1e-6)
-    assert numpy_maps.strength.min() == 0 and numpy_maps.strength.max() == 1
+    assert numpy_maps.strength.min() == np.float32(HATCHED_STRENGTH) and numpy_maps.strength.max() == 1
     np.testing.assert_allclose(gl_result, numpy_result, atol=1e-5)
 
 

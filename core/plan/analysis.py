@@ -39,7 +39,8 @@ colour lines better), then takes the first of these exits that applies, each nam
     passes at full strength and, where the filter keeps flat colours (sharpening,
     edge-aware smoothing), the pure colours of thin features with the identity as the
     table (``flat_colours``); on hatched or screentoned content under a smoothing filter
-    (``hatching``) only in its flat regions, F kept in the hatched ones (the local plan).
+    (``hatching``) at full strength in its flat regions only, at a lower one in the hatched
+    ones (the local plan).
 
 In a compressed O, texture is read in the blocks of its grid that hold no edge
 (``texture``), so that compression noise is neither texture nor edge.
@@ -62,7 +63,8 @@ from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
 from .compression import COMPRESSED_REPAIR_TO_ERROR, compression_evidence
 from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
-from .hatching import HATCHED_SHARE, SMOOTHED_CONTRAST, contrast_ratio, hatched_share, is_screentone_drawing
+from .hatching import (HATCHED_SHARE, HATCHED_STRENGTH, SMOOTHED_CONTRAST, contrast_ratio, hatched_share,
+                       is_screentone_drawing)
 from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
@@ -266,17 +268,18 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # Filters that keep flat colours (sharpening, edge-aware smoothing): thin features get
     # their pure colours with the identity as the table (plan/flat_colours.py).
     prior, kept = flat_colour_prior(o, f, edges)
-    why = (f"neighbourhood filter on hard-edged content (repair-to-error ratio {ratio:.1f}): full strength"
-           + (f", pure colours of thin features ({kept})" if prior is not None else ""))
+    pure = f", pure colours of thin features ({kept})" if prior is not None else ""
+    why = f"neighbourhood filter on hard-edged content (repair-to-error ratio {ratio:.1f}): full strength"
     # Hatching and screentone are texture, not edges to blend, for a filter that smooths them
-    # (plan/hatching.py): on a hatched O only the flat regions are repaired, F is kept in the
-    # hatched ones (the local plan with a textured strength of 0).
+    # (plan/hatching.py): on a hatched O the flat regions are repaired at full strength, the
+    # hatched ones at a lower one (the local plan).
     hatched = hatched_share(o, edges)
     if hatched >= HATCHED_SHARE and contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST:
-        return PairAnalysis(space, 1.0, why + f" in flat regions; hatching or screentone around {hatched:.2f} of "
-                                              "the edges: F kept there", Decision.NEIGHBOURHOOD_HARD_EDGED, prior,
-                            local=LocalStrength(0.0, "hatching and screentone"))
-    return PairAnalysis(space, 1.0, why, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
+        return PairAnalysis(space, 1.0, why + f" in flat regions, {HATCHED_STRENGTH:g} in the hatching or screentone "
+                                              f"around {hatched:.2f} of the edges" + pure,
+                            Decision.NEIGHBOURHOOD_HARD_EDGED, prior,
+                            local=LocalStrength(HATCHED_STRENGTH, "hatching and screentone"))
+    return PairAnalysis(space, 1.0, why + pure, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
 
 
 def _is_grey(encoded):

@@ -106,8 +106,8 @@ class LocalStrength:
     Attributes
     ----------
     textured : float
-        The factor in textured regions: the calibrated strength for a photo, in (0, 1); 0
-        for hatching and screentone under a smoothing filter (``aarecovery.plan.hatching``).
+        The factor in textured regions: the calibrated strength for a photo, in (0, 1); a
+        fixed strength for hatching and screentone under a smoothing filter (``aarecovery.plan.hatching``).
     textured_regions : str
         What the textured regions are, for the summary line.
     """
