@@ -14,8 +14,7 @@ brighter or darker than both of its neighbours along a row or a column by
 drawing's lines one per line. Where a share :data:`HATCHED_SHARE` of O's edge pixels lie in
 squares dense with extrema, O is hatched, and it is used twice:
 
-* Where F smooths a hatched O (its Laplacian at O's edges is lower than
-  :data:`SMOOTHED_CONTRAST` times O's), the plan repairs its flat regions at full strength
+* Where F smooths a hatched O (``aarecovery.plan.smoothing``), the plan repairs its flat regions at full strength
   and its hatched ones at :data:`HATCHED_STRENGTH`: the local plan of
   ``aarecovery.spec.local_plan`` (with its GL twin), whose textured regions are where O has
   no flat pixels, as the hatched and dotted regions have none. A sharpening filter keeps
@@ -36,8 +35,7 @@ import numpy as np
 from ..colour import LUMA_WEIGHTS
 from ..spec.local_plan import flat_pixels
 
-__all__ = ["hatched_share", "contrast_ratio", "HATCHED_SHARE", "DENSE_EXTREMA", "SMOOTHED_CONTRAST",
-           "is_screentone_drawing", "SCREENTONE_FLAT_SHARE",
+__all__ = ["hatched_share", "is_screentone_drawing", "HATCHED_SHARE", "DENSE_EXTREMA", "SCREENTONE_FLAT_SHARE",
            "HATCHED_STRENGTH"]
 
 # A stroke extremum differs from both neighbours along a row or a column by more than this
@@ -52,12 +50,6 @@ DENSE_EXTREMA = 0.3
 #: O is hatched when this share of its edge pixels lie in dense squares (tuning half: 0.58 at
 #: most on drawings without screentone, 0.70 at least on the screentone manga).
 HATCHED_SHARE = 0.65
-#: F smooths (rather than sharpens) when its Laplacian at O's edges is below this multiple of
-#: O's. Only smoothing averages the strokes away: under an unsharp mask the screentone manga
-#: (tuning half) gained 0.60-0.74 of its edge error at full strength everywhere and 0.10-0.13
-#: with F kept in its hatched regions. Tuning half, drawings: bilateral and edge-preserving
-#: filters 0.78-1.00, unsharp masks 1.42-2.37.
-SMOOTHED_CONTRAST = 1.2
 #: The strength in the hatched regions of a smoothed O (flat regions get full strength).
 #: Tuning half, the screentone manga under the bilateral and edge-preserving filters (6 cases,
 #: mean edge-band error reduction): 0.254 at 1 (OpenCV's bilateral lost 0.61 dB), 0.140 at 0,
@@ -95,32 +87,6 @@ def _box_mean(mask, radius):
         return (table[side:side + height, side:side + width] - table[:height, side:side + width]
                 - table[side:side + height, :width] + table[:height, :width])
     return box_sum(mask) / box_sum(np.ones(mask.shape, bool))
-
-
-def _laplacian(encoded):
-    luma = encoded @ LUMA_WEIGHTS.astype(np.float32)
-    padded = np.pad(luma, 1, mode="edge")
-    return np.abs(4 * luma - padded[:-2, 1:-1] - padded[2:, 1:-1] - padded[1:-1, :-2] - padded[1:-1, 2:])
-
-
-def contrast_ratio(original, filtered, edges):
-    """F's mean absolute Laplacian (of luma) at O's edge pixels over O's: below 1 F smooths.
-
-    Parameters
-    ----------
-    original, filtered : ndarray of float32, shape (H, W, 3)
-        Encoded colour (the analysis crop).
-    edges : ndarray of bool, shape (H, W)
-
-    Returns
-    -------
-    float
-        1 without edge pixels or where O's Laplacian is 0 there.
-    """
-    contrast = _laplacian(original)[edges].sum() if edges.any() else 0.0
-    if contrast <= 0:
-        return 1.0
-    return float(_laplacian(filtered)[edges].sum() / contrast)
 
 
 def is_screentone_drawing(encoded, edges):
