@@ -281,7 +281,9 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                               f"hatching or screentone around {hatched:.2f} of the edges" + pure,
                             Decision.NEIGHBOURHOOD_HARD_EDGED, prior,
                             local=LocalStrength(HATCHED_STRENGTH, "hatching and screentone"))
-    if smoothing:
+    # Only a filter that keeps O's flat colours and colour lines (the prior) is smoothing
+    # edges: a conversion to grey lowers the luma contrast too (GIMP's desaturate).
+    if smoothing and prior is not None:
         return PairAnalysis(space, SMOOTHED_STRENGTH, why + f": a smoothing filter, strength {SMOOTHED_STRENGTH:g}"
                             + pure, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
     return PairAnalysis(space, 1.0, why + ": full strength" + pure, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
