@@ -72,7 +72,8 @@ class RecoverySummary:
         if self.hard_edged_share is None:
             return f"strength {plan.strength:g} where hard-edged, {plan.strength * plan.local.textured:g} where textured"
         return (f"text and drawings {self.hard_edged_share:.0%} of the edges at strength {plan.strength:g}, "
-                f"photo {1 - self.hard_edged_share:.0%} at {plan.strength * plan.local.textured:g}")
+                f"{plan.local.textured_regions} {1 - self.hard_edged_share:.0%} at "
+                f"{plan.strength * plan.local.textured:g}")
 
 
 def _forcing(plan, force):

@@ -24,7 +24,8 @@ colour lines better), then takes the first of these exits that applies, each nam
    read as textured, and full strength in those that read as hard-edged (text, logos and
    lines drawn over the photo): the local plan (``aarecovery.spec.local_plan``), which the
    backends apply per tile.
-6. ``NEIGHBOURHOOD_TEXTURED_KEPT``: any other filter on a textured image that is not a
+6. ``NEIGHBOURHOOD_TEXTURED_KEPT``: any other filter on a textured image (but a comic's
+   screentone, whose dots read as grain: ``hatching``) that is not a
    colour map of all three channels at once (``colour_map``): it cannot be simulated and
    the model would flatten the texture, F is kept.
 7. ``COLOUR_MAP_KEPT``: a colour map on a textured image whose repairs are no larger than
@@ -35,9 +36,11 @@ colour lines better), then takes the first of these exits that applies, each nam
    repairs are no larger than the model's own error (a stricter bar for a compressed O):
    F is kept.
 10. ``NEIGHBOURHOOD_HARD_EDGED``: a neighbourhood filter on hard-edged content: the paper's
-    passes at full strength and, where the filter keeps flat colours (sharpening,
-    edge-aware smoothing), the pure colours of thin features with the identity as the
-    table (``flat_colours``).
+    passes at full strength (lower for a smoothing filter: ``smoothing``) and, where the
+    filter keeps flat colours (sharpening, edge-aware smoothing), the pure colours of thin
+    features with the identity as the table (``flat_colours``); on hatched or screentoned
+    content under a smoothing filter (``hatching``) full strength in its flat regions only
+    and a lower one in the hatched ones (the local plan).
 
 In a compressed O, texture is read in the blocks of its grid that hold no edge
 (``texture``), so that compression noise is neither texture nor edge.
@@ -60,11 +63,13 @@ from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
 from .compression import COMPRESSED_REPAIR_TO_ERROR, compression_evidence
 from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
+from .hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screentone_drawing
 from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import pure_colour_prior
+from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, contrast_ratio
 from .texture import is_textured
 
 __all__ = ["PairAnalysis", "analyse", "analyse_pair", "analysis_crop"]
@@ -224,8 +229,12 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # found none (strength 0), F is kept everywhere, as before.
         return PairAnalysis(space, 1.0, why + " for textured regions, full strength for hard-edged ones",
                             Decision.POINTWISE_CALIBRATED, local=LocalStrength(strength))
+    colour_map = fit_colour_map(o, f, edges) if textured else None
+    # A comic's screentone reads as texture, but it is a drawing (plan/hatching.py): under a
+    # neighbourhood filter that is no colour map it goes on to the hard-edged branch below.
+    if textured and colour_map.consistency < COLOUR_MAP_SHARE and is_screentone_drawing(o, edges):
+        textured = False
     if textured:
-        colour_map = fit_colour_map(o, f, edges)
         if colour_map.consistency < COLOUR_MAP_SHARE:
             return PairAnalysis(space, _PHOTO_NEIGHBOURHOOD_STRENGTH,
                                 f"neighbourhood filter on a textured image ({texture}): "
@@ -259,10 +268,25 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # Filters that keep flat colours (sharpening, edge-aware smoothing): thin features get
     # their pure colours with the identity as the table (plan/flat_colours.py).
     prior, kept = flat_colour_prior(o, f, edges)
-    return PairAnalysis(space, 1.0, f"neighbourhood filter on hard-edged content (repair-to-error ratio "
-                                    f"{ratio:.1f}): full strength"
-                                    + (f", pure colours of thin features ({kept})" if prior is not None else ""),
-                        Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
+    pure = f", pure colours of thin features ({kept})" if prior is not None else ""
+    why = f"neighbourhood filter on hard-edged content (repair-to-error ratio {ratio:.1f})"
+    # A smoothing filter averages part of an edge's damage away, as the reference does
+    # (plan/smoothing.py); hatching and screentone are texture to it, not edges to blend
+    # (plan/hatching.py): on a hatched O the flat regions are repaired at full strength, the
+    # hatched ones at a lower one (the local plan).
+    smoothing = contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST
+    hatched = hatched_share(o, edges)
+    if smoothing and hatched >= HATCHED_SHARE:
+        return PairAnalysis(space, 1.0, why + f": full strength in flat regions, {HATCHED_STRENGTH:g} in the "
+                                              f"hatching or screentone around {hatched:.2f} of the edges" + pure,
+                            Decision.NEIGHBOURHOOD_HARD_EDGED, prior,
+                            local=LocalStrength(HATCHED_STRENGTH, "hatching and screentone", drawn_ink=False))
+    # Only a filter that keeps O's flat colours and colour lines (the prior) is smoothing
+    # edges: a conversion to grey lowers the luma contrast too (GIMP's desaturate).
+    if smoothing and prior is not None:
+        return PairAnalysis(space, SMOOTHED_STRENGTH, why + f": a smoothing filter, strength {SMOOTHED_STRENGTH:g}"
+                            + pure, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
+    return PairAnalysis(space, 1.0, why + ": full strength" + pure, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
 
 
 def _is_grey(encoded):

@@ -229,10 +229,20 @@ class LocalStrength:
     Attributes
     ----------
     textured : float
-        The factor in textured regions (photos): the calibrated strength, in (0, 1).
+        The factor in textured regions: the calibrated strength for a photo, in (0, 1); a
+        fixed strength for hatching and screentone under a smoothing filter (``aarecovery.plan.hatching``).
+    textured_regions : str
+        What the textured regions are, for the summary line.
+    drawn_ink : bool
+        Whether drawn ink (:func:`ink_weight`) also counts as hard-edged: yes over a photo,
+        where captions and lines drawn on it repeat their colour exactly; no on hatching and
+        screentone, whose strokes repeat theirs too but lose at full strength under a
+        smoothing filter (``aarecovery.plan.hatching``).
     """
 
     textured: float
+    textured_regions: str = "photo"
+    drawn_ink: bool = True
 
     #: How far the factor at a pixel reads O (a tile's extra halo).
     reach = REACH
@@ -245,7 +255,9 @@ class LocalStrength:
         encoded : ndarray of float32, shape (H, W, 3)
             O's sRGB-encoded colour.
         """
-        weight = np.maximum(hard_edged_weight(flat_share(encoded)), ink_weight(encoded))
+        weight = hard_edged_weight(flat_share(encoded))
+        if self.drawn_ink:
+            weight = np.maximum(weight, ink_weight(encoded))
         return (np.float32(self.textured) + np.float32(1 - self.textured) * weight).astype(np.float32)
 
 

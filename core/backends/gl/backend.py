@@ -398,7 +398,8 @@ class GLBackend:
                   "strength_factor", "active"))
         for number, (inputs, output, list_name) in enumerate(steps, 1):
             where = {} if blocks is None else {"blocks": blocks[0], "list_name": list_name}
-            self._path.run_pass("local_plan", inputs, [self._work(output)], uniforms={"textured": local.textured},
+            uniforms = {"textured": local.textured, "drawn_ink": int(local.drawn_ink)}
+            self._path.run_pass("local_plan", inputs, [self._work(output)], uniforms=uniforms,
                                 defines={**defines, "LOCAL_PASS": number}, **where)
         self._factor_for = (local, blocks and blocks[1])
 

@@ -19,6 +19,7 @@ const float INK_SHARE_HIGH = 0.7;
 uniform sampler2D original_image;  // O as uploaded (passes 1 and 3)
 uniform sampler2D local_input;     // the previous pass's output (passes 2 and 3)
 uniform float textured;            // the factor in textured regions (pass 3)
+uniform int drawn_ink;             // 1: drawn ink counts as hard-edged too (pass 3)
 
 vec3 original_encoded(ivec2 p, ivec2 size) {
     vec3 c = texelFetch(original_image, clamp(p, ivec2(0), size - 1), 0).rgb;
@@ -44,24 +45,29 @@ float ink_weight(ivec2 p, ivec2 size) {
             if (b < low) { low = b; darkest = c; }
         }
     }
+    // One read of the square counts both extremes' repeats (the counts are exact integers).
+    ivec2 equal = ivec2(0);
+    ivec2 near = ivec2(0);
+    for (int dy = -INK_RADIUS; dy <= INK_RADIUS; ++dy) {
+        for (int dx = -INK_RADIUS; dx <= INK_RADIUS; ++dx) {
+            ivec2 q = p + ivec2(dx, dy);
+            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;  // not there
+            vec3 c = original_encoded(q, size);
+            vec3 d0 = abs(c - brightest);
+            vec3 d1 = abs(c - darkest);
+            vec2 distance = vec2(max(d0.r, max(d0.g, d0.b)), max(d1.r, max(d1.g, d1.b)));
+            ivec2 is_equal = ivec2(lessThanEqual(distance, vec2(FLAT_SPAN)));
+            equal += is_equal;
+            near += (1 - is_equal) * ivec2(lessThanEqual(distance, vec2(INK_NEAR_SPAN)));
+        }
+    }
     vec3 centre = original_encoded(p, size);
     float weight = 0.0;
     for (int side = 0; side < 2; ++side) {
         vec3 ink = side == 0 ? brightest : darkest;
         vec3 other = side == 0 ? darkest : brightest;
-        int equal = 0;
-        int near = 0;
-        for (int dy = -INK_RADIUS; dy <= INK_RADIUS; ++dy) {
-            for (int dx = -INK_RADIUS; dx <= INK_RADIUS; ++dx) {
-                ivec2 q = p + ivec2(dx, dy);
-                if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;  // not there
-                vec3 d = abs(original_encoded(q, size) - ink);
-                float distance = max(d.r, max(d.g, d.b));
-                if (distance <= FLAT_SPAN) equal += 1;
-                else if (distance <= INK_NEAR_SPAN) near += 1;
-            }
-        }
-        bool drawn = equal >= INK_REPEATS && 2 * near <= equal && max(ink.r, max(ink.g, ink.b)) > INK_DARK;
+        bool drawn = equal[side] >= INK_REPEATS && 2 * near[side] <= equal[side]
+                     && max(ink.r, max(ink.g, ink.b)) > INK_DARK;
         vec3 across = other - ink;
         vec3 from_ink = centre - ink;
         float span = sqrt(across.r * across.r + across.g * across.g + across.b * across.b);
@@ -108,7 +114,8 @@ float local_plan(ivec2 p, ivec2 size) {
     ivec2 high = min(p + REGION_RADIUS, size - 1);
     float inside = float((high.x - low.x + 1) * (high.y - low.y + 1));
     float t = clamp((count / inside - TEXTURED_SHARE) / (HARD_EDGED_SHARE - TEXTURED_SHARE), 0.0, 1.0);
-    float weight = max(t * t * (3.0 - 2.0 * t), ink_weight(p, size));
+    float weight = t * t * (3.0 - 2.0 * t);
+    if (drawn_ink != 0 && weight < 1.0) weight = max(weight, ink_weight(p, size));  // the ink is at most 1
     return textured + (1.0 - textured) * weight;
 #endif
 }
