@@ -10,7 +10,8 @@ import aarecovery
 from aarecovery import Decision
 from aarecovery.lab.metrics import edge_band, psnr
 from aarecovery.lab.realtools import FAMILIES, render_family, render_scene
-from aarecovery.plan.paper_grain import COARSE_GRAIN_SPAN, paper_grain
+from aarecovery.params import SIGMA_E
+from aarecovery.plan.paper_grain import COARSE_GRAIN_SPAN, GRAIN_EDGE_SCALE, paper_grain
 from aarecovery.plan.resample import box_downsample
 
 _WIDTH = 64
@@ -41,6 +42,7 @@ def test_a_light_grain_is_measured_and_a_coarse_one_is_called_coarse():
     light, coarse = paper_grain(_original("memo")), paper_grain(_original("notice"))
     assert 0 < light.span < COARSE_GRAIN_SPAN < coarse.span
     assert not light.coarse and coarse.coarse
+    assert light.edge_scale == 1.0 and coarse.edge_scale == GRAIN_EDGE_SCALE > 1
 
 
 def _equalize_table(scene):
@@ -76,5 +78,6 @@ def test_text_on_grained_paper_under_equalization_is_no_worse_than_f():
         engine.run(plan)
         recovered = engine.result()[..., :3]
     assert plan.decision == Decision.POINTWISE_HARD_EDGED_GRAINED, plan.reason
+    assert plan.sigma_e == pytest.approx(SIGMA_E.default * GRAIN_EDGE_SCALE)
     band = edge_band(original, filtered, reference)
     assert psnr(recovered, reference, band) >= psnr(filtered, reference, band) - 0.1

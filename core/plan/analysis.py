@@ -106,6 +106,9 @@ class PairAnalysis:
         the textured regions'.
     forcing : Forcing or None
         Where F is kept: what forcing a repair would do (``aarecovery.plan.forcing``).
+    edge_scale : float
+        Multiplies the edge-strength scale ``sigma_e`` the passes run at: above 1 on a page
+        with a coarse paper grain (``aarecovery.plan.paper_grain``), whose weak edges are grain.
     """
 
     blend_space: str
@@ -115,6 +118,7 @@ class PairAnalysis:
     pure_colours: object = None
     local: object = None
     forcing: object = None
+    edge_scale: float = 1.0
 
 
 def analysis_crop(image):
@@ -210,6 +214,10 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
             # paper grain does the same: the tuning half's grained page (notice) under
             # levels, equalization and posterize lost up to 2.0 dB at full strength (pure
             # colours above the grain), calibrated none (its mean 0.25 -> 0.58).
+            # On a coarse grain the passes also run at a larger sigma_e (grain.edge_scale), so
+            # that the grain's weak edges get little confidence and the bare paper stays as F
+            # has it; the calibration runs at the user's: at the larger scale it chose
+            # strengths that lost up to 0.9 dB on the tuning half's grained page.
             strength, errors = calibrate_strength(o, transfer, f, space, sigma_d, sigma_e, iterations)
             if compression.compressed:
                 decision, above = Decision.POINTWISE_HARD_EDGED_COMPRESSED, compression.describe()
@@ -219,7 +227,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                 f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges match) "
                                 f"on hard-edged content{thin} above {above}; half-resolution "
                                 f"calibration chose strength {strength:g}", decision, prior,
-                                forcing=forcing_advice(decision, errors=errors) if strength == 0 else None)
+                                forcing=forcing_advice(decision, errors=errors) if strength == 0 else None,
+                                edge_scale=grain.edge_scale)
         return PairAnalysis(space, 1.0, f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges "
                                         f"match) on hard-edged content: full strength{thin}",
                             Decision.POINTWISE_HARD_EDGED, prior)

@@ -18,7 +18,12 @@ pages 38-39 levels). So:
 * extremes closer than :data:`GRAIN_SPAN_FACTOR` times the quiet span are grain, not a thin
   feature on its paper (text's contrast, 150-200 levels, stays far above);
 * a quiet span over :data:`COARSE_GRAIN_SPAN` is a coarse grain, which goes through the
-  filter like a JPEG's noise: the strength is calibrated, as for a compressed O.
+  filter like a JPEG's noise: the strength is calibrated, as for a compressed O, and the
+  passes run at :data:`GRAIN_EDGE_SCALE` times the edge-strength scale ``sigma_e``. The
+  confidence is ``1 - exp(-(e / sigma_e)^2)`` with ``e`` the product of O's and F's
+  gradients: the grain's ``e`` is about 0.01 (O's gradient 0.03-0.05 times what the filter
+  makes of it), text's 0.1-0.3, so a larger scale leaves the bare paper as F has it (the
+  haze a repair paints there) and the letters repaired.
 """
 
 from dataclasses import dataclass
@@ -27,7 +32,7 @@ import numpy as np
 
 from ..colour import LUMA
 
-__all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN"]
+__all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN", "GRAIN_EDGE_SCALE"]
 
 #: The pure colours' contrast floor, in multiples of the quiet pixels' 3 x 3 luma span.
 #: Tuning half, scans under levels, equalization, posterize and thresholds (memo and notice,
@@ -35,6 +40,8 @@ __all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN"
 GRAIN_SPAN_FACTOR = 8.0
 #: A quiet span above this (encoded) is a coarse grain: memo 3.7 levels, notice 8.9.
 COARSE_GRAIN_SPAN = 6.0 / 255
+#: ``sigma_e`` is multiplied by this on a coarse grain.
+GRAIN_EDGE_SCALE = 10.0
 # The quiet pixels are this percentile of the 3 x 3 luma span: below every drawing's share
 # of flat pixels (0.08 on the densest, the Ben-Day comic) and within a page's bare paper.
 _QUIET_PERCENTILE = 5.0
@@ -55,6 +62,11 @@ class PaperGrain:
     def coarse(self):
         """bool: the grain goes through the filter like compression noise."""
         return self.span > COARSE_GRAIN_SPAN
+
+    @property
+    def edge_scale(self):
+        """float: what ``sigma_e`` is multiplied by (1 unless the grain is coarse)."""
+        return GRAIN_EDGE_SCALE if self.coarse else 1.0
 
     def describe(self):
         """The grain in words, for the plan's reason."""
