@@ -38,6 +38,16 @@ def test_dense_colour_dots_are_no_coarse_grain():
     assert not paper_grain(_original("comicstrip")).coarse
 
 
+def test_dense_lines_with_no_flat_pixel_are_no_grain():
+    """The built-in line scene has no flat pixel either, but its quietest pixels span 67-115
+    levels: content, whose thin lines keep their pure colours."""
+    from aarecovery.lab import scenes
+    from aarecovery.lab.groundtruth import make_case
+    for space in ("linear", "srgb"):
+        original = make_case(scenes.render("lines", 80, 4), "gamma", 4, space).original
+        assert paper_grain(original).span == 0.0
+
+
 def test_a_light_grain_is_measured_and_a_coarse_one_is_called_coarse():
     light, coarse = paper_grain(_original("memo")), paper_grain(_original("notice"))
     assert 0 < light.span < COARSE_GRAIN_SPAN < coarse.span

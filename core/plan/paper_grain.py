@@ -32,7 +32,8 @@ import numpy as np
 
 from ..colour import LUMA
 
-__all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN", "GRAIN_EDGE_SCALE"]
+__all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN", "GRAIN_EDGE_SCALE",
+           "MAX_GRAIN_SPAN"]
 
 #: The pure colours' contrast floor, in multiples of the quiet pixels' 3 x 3 luma span.
 #: Tuning half, scans under levels, equalization, posterize and thresholds (memo and notice,
@@ -42,6 +43,10 @@ GRAIN_SPAN_FACTOR = 8.0
 COARSE_GRAIN_SPAN = 6.0 / 255
 #: ``sigma_e`` is multiplied by this on a coarse grain.
 GRAIN_EDGE_SCALE = 10.0
+#: A quiet span above this is no paper grain but content with no flat pixel: the built-in
+#: suite's dense lines span 67 (linear) and 115 (sRGB) levels there, and with their quiet
+#: span as a grain lost their pure colours (quick suite 0.792 -> 0.693 linear).
+MAX_GRAIN_SPAN = 24.0 / 255
 # The quiet pixels are this percentile of the 3 x 3 luma span: below every drawing's share
 # of flat pixels (0.08 on the densest, the Ben-Day comic) and within a page's bare paper.
 _QUIET_PERCENTILE = 5.0
@@ -49,7 +54,7 @@ _QUIET_PERCENTILE = 5.0
 
 @dataclass(frozen=True)
 class PaperGrain:
-    """O's quietest 3 x 3 luma span (encoded): 0 where O has flat areas."""
+    """O's quietest 3 x 3 luma span (encoded): 0 where O has flat areas, or none that is grain."""
 
     span: float
 
@@ -90,4 +95,5 @@ def paper_grain(encoded):
     padded = np.pad(luma, 1, mode="edge")
     shifted = [padded[dy:dy + height, dx:dx + width] for dy in range(3) for dx in range(3)]
     span = np.max(shifted, axis=0) - np.min(shifted, axis=0)
-    return PaperGrain(float(np.percentile(span, _QUIET_PERCENTILE)))
+    quiet = float(np.percentile(span, _QUIET_PERCENTILE))
+    return PaperGrain(quiet if quiet <= MAX_GRAIN_SPAN else 0.0)
