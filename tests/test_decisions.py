@@ -57,6 +57,13 @@ def _jpeg_page_thresholded(quality=85):
     return original, filtered
 
 
+def _grained_page_levels():
+    """A page of text on coarse-grained tinted paper under narrow levels."""
+    page = _box(render_family("notice", 64), 8)
+    original = (np.rint(page * 255) / 255).astype(np.float32)
+    return original, np.clip((original - 0.3) / 0.4, 0, 1).astype(np.float32)
+
+
 def _quantised_photo():
     original = _photo_like(seed=2)
     return original, _quantise(original, PALETTE)
@@ -66,6 +73,7 @@ PAIRS = {
     Decision.LOWPASS_KEPT: lambda: _case("shapes", "blur"),
     Decision.AFFINE_KEPT: _channel_mixer,
     Decision.POINTWISE_HARD_EDGED_COMPRESSED: _jpeg_page_thresholded,
+    Decision.POINTWISE_HARD_EDGED_GRAINED: _grained_page_levels,
     Decision.POINTWISE_HARD_EDGED: lambda: _case("shapes", "posterize"),
     Decision.POINTWISE_CALIBRATED: lambda: _case("astronaut", "posterize"),
     Decision.NEIGHBOURHOOD_TEXTURED_KEPT: lambda: _case("astronaut", "unsharp"),

@@ -35,6 +35,10 @@ class Decision(str, enum.Enum):
     """A point-wise filter on hard-edged content whose O was JPEG-compressed: the strength
     self-calibration finds (the compression noise goes through the filter too), and pure
     colours of thin features only between extremes farther apart than that noise."""
+    POINTWISE_HARD_EDGED_GRAINED = "pointwise-hard-edged-grained"
+    """The same on a scanned page whose coarse paper grain leaves no flat pixel
+    (``aarecovery.plan.paper_grain``): the grain goes through the filter like compression
+    noise, so the calibrated strength, and pure colours only above the grain."""
     POINTWISE_CALIBRATED = "pointwise-calibrated"
     """A point-wise filter on a textured image: the strength self-calibration finds, in the
     regions that read as textured; full strength in those that read as hard-edged (text or

@@ -196,8 +196,13 @@ def _letter(height, width, k):
     return _page(height, width, k, (0.84, 0.87, 0.9), 0.03, (0.12, 0.12, 0.3), (8, 7, 10, 7), True, 29)
 
 
+def _notice(height, width, k):
+    """Serif text, 7-10 px, in sepia on buff recycled paper with a coarse grain (the tuning half's grained page)."""
+    return _page(height, width, k, (0.88, 0.84, 0.74), 0.03, (0.22, 0.14, 0.08), (8, 9, 7, 10), False, 31)
+
+
 #: Scan family -> ``render(height, width, k) -> (scene, ink mask)``.
-SCANS = {"memo": _memo, "letter": _letter}
+SCANS = {"memo": _memo, "letter": _letter, "notice": _notice}
 
 
 def _blocks_any(mask, k):

@@ -55,6 +55,8 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
         analysis = analyse_pair(original, filtered, linear, quantization)
     # A strength the user gives overrides the analysis's, and its local plan, and forces a
     # repair where it keeps F; the other decisions (blend space, pure colours) stand.
+    # A coarse paper grain raises the edge-strength scale (plan/paper_grain.py).
+    common["sigma_e"] = parameters.sigma_e * analysis.edge_scale
     return Plan(**common, blend_space=blend_space or analysis.blend_space,
                 strength=analysis.strength if asked is None else asked, pure_colours=analysis.pure_colours,
                 mode="safe", decision=analysis.decision, local=analysis.local if asked is None else None,

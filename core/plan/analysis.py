@@ -17,6 +17,8 @@ colour lines better), then takes the first of these exits that applies, each nam
    file's tables, or the block grid in its pixels): the calibrated strength, since the
    compression noise goes through the filter too, and the pure colours of thin features
    only between extremes farther apart than that noise.
+   ``POINTWISE_HARD_EDGED_GRAINED`` (``paper_grain``): the same where O is a page with a
+   coarse paper grain and no flat pixel, which goes through the filter like that noise.
 4. ``POINTWISE_HARD_EDGED``: the same on uncompressed hard-edged content: full strength
    and, for a monotone table, the pure colours of thin features (``pure_colours``).
 5. ``POINTWISE_CALIBRATED``: the same on textured content (a photo): the strength that
@@ -67,6 +69,7 @@ from .hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screent
 from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
+from .paper_grain import paper_grain
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import pure_colour_prior
 from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, contrast_ratio
@@ -108,6 +111,9 @@ class PairAnalysis:
         the textured regions'.
     forcing : Forcing or None
         Where F is kept: what forcing a repair would do (``aarecovery.plan.forcing``).
+    edge_scale : float
+        Multiplies the edge-strength scale ``sigma_e`` the passes run at: above 1 on a page
+        with a coarse paper grain (``aarecovery.plan.paper_grain``), whose weak edges are grain.
     """
 
     blend_space: str
@@ -117,6 +123,7 @@ class PairAnalysis:
     pure_colours: object = None
     local: object = None
     forcing: object = None
+    edge_scale: float = 1.0
 
 
 def analysis_crop(image):
@@ -197,21 +204,36 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # With a monotone per-channel or luma table, thin features get their pure colours:
         # quick suite 0.600 -> 0.712 (linear), 0.628 -> 0.686 (sRGB); the table's ends
         # extended by a power law: 0.774 / 0.734.
-        prior = pure_colour_prior(o, transfer, space, f, edges, noise_contrast=compression.contrast)
+        # Neither compression noise nor a scanned page's paper grain (plan/paper_grain.py) is a
+        # thin feature: pure colours only between extremes farther apart than both.
+        grain = paper_grain(o)
+        prior = pure_colour_prior(o, transfer, space, f, edges,
+                                  noise_contrast=max(compression.contrast, grain.contrast))
         thin = ", pure colours of thin features" if prior is not None else ""
-        if compression.compressed:
+        if compression.compressed or grain.coarse:
             # A JPEG's noise goes through the filter too (a levels curve doubles it): full
             # strength lost up to 2.4 dB against F on the tuning half (the star burst under
             # GEGL's levels at q 90, serif under G'MIC's pow 3 at q 75 0.9 dB); calibrated,
             # none lost, and the JPEG drawings this branch takes gained 0.59 in summed error
-            # reduction over the textured (calibrated, no pure colours) reading.
+            # reduction over the textured (calibrated, no pure colours) reading. A coarse
+            # paper grain does the same: the tuning half's grained page (notice) under
+            # levels, equalization and posterize lost up to 2.0 dB at full strength (pure
+            # colours above the grain), calibrated none (its mean 0.25 -> 0.58).
+            # On a coarse grain the passes also run at a larger sigma_e (grain.edge_scale), so
+            # that the grain's weak edges get little confidence and the bare paper stays as F
+            # has it; the calibration runs at the user's: at the larger scale it chose
+            # strengths that lost up to 0.9 dB on the tuning half's grained page.
             strength, errors = calibrate_strength(o, transfer, f, space, sigma_d, sigma_e, iterations)
-            decision = Decision.POINTWISE_HARD_EDGED_COMPRESSED
+            if compression.compressed:
+                decision, above = Decision.POINTWISE_HARD_EDGED_COMPRESSED, compression.describe()
+            else:
+                decision, above = Decision.POINTWISE_HARD_EDGED_GRAINED, grain.describe()
             return PairAnalysis(space, strength,
                                 f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges match) "
-                                f"on hard-edged content{thin} above {compression.describe()}; half-resolution "
+                                f"on hard-edged content{thin} above {above}; half-resolution "
                                 f"calibration chose strength {strength:g}", decision, prior,
-                                forcing=forcing_advice(decision, errors=errors) if strength == 0 else None)
+                                forcing=forcing_advice(decision, errors=errors) if strength == 0 else None,
+                                edge_scale=grain.edge_scale)
         return PairAnalysis(space, 1.0, f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges "
                                         f"match) on hard-edged content: full strength{thin}",
                             Decision.POINTWISE_HARD_EDGED, prior)

@@ -1,0 +1,99 @@
+"""A scanned page's paper grain: how far it varies, and whether it is coarse.
+
+A scanned page has no exactly flat pixel: its paper carries a grain a few pixels across,
+which O's Sobel reads as edges (a coarse grain is steeper than
+``calibration.EDGE_GRADIENT``), while too many pixels lie near an edge for
+``texture.grain`` to be measured, so the colour lines call the page hard-edged. The pure
+colours of thin features then take two grain pixels for a thin stroke and its paper and
+paint the filter's extrapolated ink between them, and under equalization, narrow levels and
+posterization the table stretches the grain into the repair: full strength with pure colours
+lost up to 7.2 dB against F on such pages.
+
+The quietest pixels tell the grain: a drawing's flat fills span nothing (the 5th percentile
+of the 3 x 3 luma span is 0 on every real-tools drawing and comic), a page's bare paper spans
+its grain (3.7 levels on the light-grained memo, 8.9 on the coarse-grained notice and
+letter), and the largest span of bare paper is about 4.5 times that (memo 16.6, the coarse
+pages 38-39 levels). So:
+
+* extremes closer than :data:`GRAIN_SPAN_FACTOR` times the quiet span are grain, not a thin
+  feature on its paper (text's contrast, 150-200 levels, stays far above);
+* a quiet span over :data:`COARSE_GRAIN_SPAN` is a coarse grain, which goes through the
+  filter like a JPEG's noise: the strength is calibrated, as for a compressed O, and the
+  passes run at :data:`GRAIN_EDGE_SCALE` times the edge-strength scale ``sigma_e``. The
+  confidence is ``1 - exp(-(e / sigma_e)^2)`` with ``e`` the product of O's and F's
+  gradients: the grain's ``e`` is about 0.01 (O's gradient 0.03-0.05 times what the filter
+  makes of it), text's 0.1-0.3, so a larger scale leaves the bare paper as F has it (the
+  haze a repair paints there) and the letters repaired.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..colour import LUMA
+
+__all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN", "GRAIN_EDGE_SCALE",
+           "MAX_GRAIN_SPAN"]
+
+#: The pure colours' contrast floor, in multiples of the quiet pixels' 3 x 3 luma span.
+#: Tuning half, scans under levels, equalization, posterize and thresholds (memo and notice,
+#: PNG and JPEG): 5 -> notice worst loss 2.83 dB, 8 -> 1.98, 12 -> 1.56, memo 0.779-0.788.
+GRAIN_SPAN_FACTOR = 8.0
+#: A quiet span above this (encoded) is a coarse grain: memo 3.7 levels, notice 8.9.
+COARSE_GRAIN_SPAN = 6.0 / 255
+#: ``sigma_e`` is multiplied by this on a coarse grain.
+GRAIN_EDGE_SCALE = 10.0
+#: A quiet span above this is no paper grain but content with no flat pixel: the built-in
+#: suite's dense lines span 67 (linear) and 115 (sRGB) levels there, and with their quiet
+#: span as a grain lost their pure colours (quick suite 0.792 -> 0.693 linear).
+MAX_GRAIN_SPAN = 24.0 / 255
+# The quiet pixels are this percentile of the 3 x 3 luma span: below every drawing's share
+# of flat pixels (0.08 on the densest, the Ben-Day comic) and within a page's bare paper.
+_QUIET_PERCENTILE = 5.0
+
+
+@dataclass(frozen=True)
+class PaperGrain:
+    """O's quietest 3 x 3 luma span (encoded): 0 where O has flat areas, or none that is grain."""
+
+    span: float
+
+    @property
+    def contrast(self):
+        """float: the contrast two extremes need to be told from the grain (encoded)."""
+        return GRAIN_SPAN_FACTOR * self.span
+
+    @property
+    def coarse(self):
+        """bool: the grain goes through the filter like compression noise."""
+        return self.span > COARSE_GRAIN_SPAN
+
+    @property
+    def edge_scale(self):
+        """float: what ``sigma_e`` is multiplied by (1 unless the grain is coarse)."""
+        return GRAIN_EDGE_SCALE if self.coarse else 1.0
+
+    def describe(self):
+        """The grain in words, for the plan's reason."""
+        return f"paper grain ({self.span * 255:.1f} levels)"
+
+
+def paper_grain(encoded):
+    """Measure O's paper grain from its quietest pixels.
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (H, W, 3)
+        O's encoded colour (the analysis crop).
+
+    Returns
+    -------
+    PaperGrain
+    """
+    luma = encoded @ np.asarray(LUMA, np.float32)
+    height, width = luma.shape
+    padded = np.pad(luma, 1, mode="edge")
+    shifted = [padded[dy:dy + height, dx:dx + width] for dy in range(3) for dx in range(3)]
+    span = np.max(shifted, axis=0) - np.min(shifted, axis=0)
+    quiet = float(np.percentile(span, _QUIET_PERCENTILE))
+    return PaperGrain(quiet if quiet <= MAX_GRAIN_SPAN else 0.0)
