@@ -42,7 +42,9 @@ colour lines better), then takes the first of these exits that applies, each nam
     filter keeps flat colours (sharpening, edge-aware smoothing), the pure colours of thin
     features with the identity as the table (``flat_colours``); on hatched or screentoned
     content under a smoothing filter (``hatching``) full strength in its flat regions only
-    and a lower one in the hatched ones (the local plan).
+    and a lower one in the hatched ones (the local plan); on a page with a coarse paper
+    grain under a smoothing filter (``paper_grain``) half strength at the grain's sigma_e
+    and no pure colours.
 
 In a compressed O, texture is read in the blocks of its grid that hold no edge
 (``texture``), so that compression noise is neither texture nor edge.
@@ -69,7 +71,7 @@ from .hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screent
 from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
-from .paper_grain import paper_grain
+from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, paper_grain
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import pure_colour_prior
 from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, contrast_ratio
@@ -287,16 +289,29 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                         f"{needed:g}" + (f" above {compression.describe()}" if compression.compressed
                                                          else "") + "): kept F", Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT,
                             forcing=forcing_advice(Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT, ratio))
+    # A smoothing filter averages part of an edge's damage away, as the reference does
+    # (plan/smoothing.py).
+    smoothing = contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST
+    # On a page with a coarse paper grain (plan/paper_grain.py) it spreads the grain as it
+    # spreads a JPEG's noise, so the repair runs at the grain's sigma_e, at a lower strength
+    # and without pure colours. Tuning half, notice under the three tuning smoothing filters
+    # (PNG and JPEG): full strength lost up to 1.51 dB; at the grain's sigma_e and strength
+    # 0.5 no case lost (see GRAINED_NEIGHBOURHOOD_STRENGTH). Sharpening filters (unsharp
+    # masks) keep full strength: at 0.5 the coarse page's gain fell from 0.45-0.52 to 0.21-0.23.
+    grain = paper_grain(o)
+    if smoothing and grain.coarse:
+        return PairAnalysis(space, GRAINED_NEIGHBOURHOOD_STRENGTH,
+                            f"neighbourhood filter on hard-edged content (repair-to-error ratio {ratio:.1f}) that "
+                            f"smooths {grain.describe()}: strength {GRAINED_NEIGHBOURHOOD_STRENGTH:g}",
+                            Decision.NEIGHBOURHOOD_HARD_EDGED, edge_scale=grain.edge_scale)
     # Filters that keep flat colours (sharpening, edge-aware smoothing): thin features get
     # their pure colours with the identity as the table (plan/flat_colours.py).
     prior, kept = flat_colour_prior(o, f, edges)
     pure = f", pure colours of thin features ({kept})" if prior is not None else ""
     why = f"neighbourhood filter on hard-edged content (repair-to-error ratio {ratio:.1f})"
-    # A smoothing filter averages part of an edge's damage away, as the reference does
-    # (plan/smoothing.py); hatching and screentone are texture to it, not edges to blend
+    # Hatching and screentone are texture to a smoothing filter, not edges to blend
     # (plan/hatching.py): on a hatched O the flat regions are repaired at full strength, the
     # hatched ones at a lower one (the local plan).
-    smoothing = contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST
     hatched = hatched_share(o, edges)
     if smoothing and hatched >= HATCHED_SHARE:
         return PairAnalysis(space, 1.0, why + f": full strength in flat regions, {HATCHED_STRENGTH:g} in the "

@@ -33,7 +33,7 @@ import numpy as np
 from ..colour import LUMA
 
 __all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN", "GRAIN_EDGE_SCALE",
-           "MAX_GRAIN_SPAN"]
+           "MAX_GRAIN_SPAN", "GRAINED_NEIGHBOURHOOD_STRENGTH"]
 
 #: The pure colours' contrast floor, in multiples of the quiet pixels' 3 x 3 luma span.
 #: Tuning half, scans under levels, equalization, posterize and thresholds (memo and notice,
@@ -43,6 +43,13 @@ GRAIN_SPAN_FACTOR = 8.0
 COARSE_GRAIN_SPAN = 6.0 / 255
 #: ``sigma_e`` is multiplied by this on a coarse grain.
 GRAIN_EDGE_SCALE = 10.0
+#: The strength under a smoothing filter on a coarse grain (at the grain's ``sigma_e``, no
+#: pure colours; ``aarecovery.plan.analysis``). Tuning half, notice under the five tuning
+#: neighbourhood filters, PNG and JPEG: full strength at the user's sigma_e 11 cases worse
+#: than F by over 0.1 dB (worst 1.51 dB); at the grain's sigma_e 1: 2 (0.33 dB), 0.75: 0
+#: (worst 0.09 dB), 0.5: 0 (worst 0.00 dB); unsharp masks keep full strength (at 0.5 their
+#: gain on notice fell from 0.45-0.52 to 0.21-0.23).
+GRAINED_NEIGHBOURHOOD_STRENGTH = 0.5
 #: A quiet span above this is no paper grain but content with no flat pixel: the built-in
 #: suite's dense lines span 67 (linear) and 115 (sRGB) levels there, and with their quiet
 #: span as a grain lost their pure colours (quick suite 0.792 -> 0.693 linear).
