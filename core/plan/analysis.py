@@ -44,7 +44,8 @@ colour lines better), then takes the first of these exits that applies, each nam
     content under a smoothing filter (``hatching``) full strength in its flat regions only
     and a lower one in the hatched ones (the local plan); on a page with a coarse paper
     grain under a smoothing filter (``paper_grain``) half strength at the grain's sigma_e
-    and no pure colours.
+    and no pure colours; from a JPEG under a smoothing filter (``compression``), not
+    hatched, half strength and no pure colours.
 
 In a compressed O, texture is read in the blocks of its grid that hold no edge
 (``texture``), so that compression noise is neither texture nor edge.
@@ -64,7 +65,7 @@ from ..spec.sobel import gradient_magnitude
 from .blend_space import choose_blend_space
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
-from .compression import COMPRESSED_REPAIR_TO_ERROR, compression_evidence
+from .compression import COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SMOOTHED_STRENGTH, compression_evidence
 from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
 from .hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screentone_drawing
@@ -318,6 +319,12 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                               f"hatching or screentone around {hatched:.2f} of the edges" + pure,
                             Decision.NEIGHBOURHOOD_HARD_EDGED, prior,
                             local=LocalStrength(HATCHED_STRENGTH, "hatching and screentone", drawn_ink=False))
+    # A JPEG's noise goes through a smoothing filter too, spread over the edges: the repair
+    # at a lower strength, without pure colours (see COMPRESSED_SMOOTHED_STRENGTH).
+    if smoothing and compression.compressed:
+        return PairAnalysis(space, COMPRESSED_SMOOTHED_STRENGTH,
+                            why + f": a smoothing filter above {compression.describe()}, strength "
+                                  f"{COMPRESSED_SMOOTHED_STRENGTH:g}", Decision.NEIGHBOURHOOD_HARD_EDGED)
     # Only a filter that keeps O's flat colours and colour lines (the prior) is smoothing
     # edges: a conversion to grey lowers the luma contrast too (GIMP's desaturate).
     if smoothing and prior is not None:
