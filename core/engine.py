@@ -1,5 +1,6 @@
 """The reusable recovery engine: one backend, one pair of images, plans that change."""
 
+import dataclasses
 import functools
 import threading
 import time
@@ -10,7 +11,7 @@ from .contract import check_same_size, from_rgba_float, layout_of, native_byte_o
 from .errors import InputError
 from .params import DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, STRENGTH, Parameters, check_blend_space
 from .plan import analyse_pair, make_plan
-from .sample import array_sample
+from .sample import array_window
 
 __all__ = ["Engine", "RecoveryMaps"]
 
@@ -85,6 +86,7 @@ class Engine:
         self._pair = None
         self._loaded_space = None
         self._analysis = None
+        self._window = None
         self._quantization = None
         self.last_seconds = None
         #: Plan or None: what the last :meth:`compute` or :meth:`run` did (mode, blend space,
@@ -154,6 +156,7 @@ class Engine:
         self._layout = f_layout
         self._pair = (original, o_layout, filtered, f_layout, bool(linear), blend_space)
         self._analysis = None
+        self._window = None
         self._quantization = quantization
         self._load(blend_space or "linear")
 
@@ -199,10 +202,13 @@ class Engine:
         self._require_images()
         original, _, filtered, _, linear, blend_space = self._pair
         parameters = Parameters(sigma_d, sigma_e, iterations, strength)
-        if mode == "safe" and self._analysis is None:
-            self._analysis = analyse_pair(*array_sample(original, filtered), linear, self._quantization)
-        return make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space,
-                         analysis=self._analysis)
+        if mode != "safe":
+            return make_plan(original, filtered, parameters, mode=mode, linear=linear, blend_space=blend_space)
+        if self._analysis is None:
+            self._window = array_window(original)
+            self._analysis = analyse_pair(original[self._window], filtered[self._window], linear, self._quantization)
+        return dataclasses.replace(make_plan(original, filtered, parameters, mode=mode, linear=linear,
+                                             blend_space=blend_space, analysis=self._analysis), window=self._window)
 
     @_exclusive
     def compute(self, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.default, iterations=ITERATIONS.default,
@@ -345,6 +351,7 @@ class Engine:
         self._layout = None
         self._pair = None
         self._analysis = None
+        self._window = None
         self._loaded_space = None
 
     def __enter__(self):

@@ -5,6 +5,7 @@ tiles with a halo (``aarecovery.tiling``) -> load and run each tile in an Engine
 backend's passes) -> assemble the result in the filtered image's layout and dtype.
 """
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -18,7 +19,7 @@ from .params import (DEFAULT_MODE, ITERATIONS, SIGMA_D, SIGMA_E, STRENGTH, Param
                      check_gl_path, check_mode)
 from .plan import make_plan
 from .plan.order import check_order
-from .sample import array_sample
+from .sample import array_window
 from .tiling import DEFAULT_TILES, check_tile_size, halo_for, tiles
 
 __all__ = ["recover", "recover_tiles", "tile_side"]
@@ -129,9 +130,10 @@ def recover(original, filtered, *, sigma_d=SIGMA_D.default, sigma_e=SIGMA_E.defa
     try:
         if plan is None:
             # The paper's method reads nothing of the pair: no window to choose (50 ms at 4096^2).
-            pair = array_sample(original, filtered) if mode == "safe" else (original, filtered)
-            plan = make_plan(*pair, parameters, mode=mode, linear=linear, blend_space=blend_space,
-                             quantization=quantization)
+            window = array_window(original) if mode == "safe" else None
+            pair = (original, filtered) if window is None else (original[window], filtered[window])
+            plan = dataclasses.replace(make_plan(*pair, parameters, mode=mode, linear=linear, blend_space=blend_space,
+                                                 quantization=quantization), window=window)
         if plan.keeps_filtered and not return_maps:
             if engine is not None:
                 engine.last_plan = plan

@@ -27,7 +27,7 @@ import numpy as np
 from .colour import luma
 from .plan.analysis import analysis_crop
 
-__all__ = ["analysis_sample", "array_sample", "analysis_window", "analysis_windows"]
+__all__ = ["analysis_sample", "array_sample", "array_window", "analysis_window", "analysis_windows"]
 
 # Grid positions per axis: 64 windows of 512 x 512 read 17 megapixels of O, a few seconds
 # of decoding at most for a gigapixel tiled TIFF, and 13 windows (40 ms) for 1920 x 1080.
@@ -107,8 +107,12 @@ def analysis_window(read_original, height, width):
     return windows[int(np.argmax(scores))]
 
 
+def array_window(original):
+    """:func:`analysis_window` of an image held in memory: its rows and columns (two slices)."""
+    return analysis_window(lambda rows, cols: original[rows, cols], *original.shape[:2])
+
+
 def array_sample(original, filtered):
     """:func:`analysis_sample` of a pair held in memory."""
-    height, width = original.shape[:2]
-    return analysis_sample(lambda rows, cols: original[rows, cols], lambda rows, cols: filtered[rows, cols],
-                           height, width)
+    window = array_window(original)
+    return original[window], filtered[window]

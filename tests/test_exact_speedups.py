@@ -93,3 +93,42 @@ def test_a_model_fitted_on_some_pixels_is_the_whole_fit_there():
     for name in ("alpha", "beta", "index_a", "index_b", "residual"):
         np.testing.assert_array_equal(getattr(some, name)[only], getattr(whole, name)[only])
     assert not some.beta[~only].any() and (some.alpha[~only] == 0.5).all()
+
+
+def _drawn_and_noisy(seed, height=48, width=40):
+    """Flat colours in blocks (ties, exact recurrences), some pixels nudged by less and more
+    than the flat span, black and the image's borders included."""
+    rng = np.random.default_rng(seed)
+    levels = rng.integers(0, 4, (height // 4, width // 4, 3)) / np.float32(3)
+    image = np.repeat(np.repeat(levels, 4, 0), 4, 1)[:height, :width].astype(np.float32)
+    image[:, : width // 4] = 0
+    nudges = rng.choice(np.array([0, 0, 0.4, 0.6, 3.0], np.float32) / 255, image.shape)
+    return np.clip(image + nudges, 0, 1).astype(np.float32)
+
+
+def _direct_flat_pixels(encoded):
+    from aarecovery.spec.local_plan import FLAT_SPAN
+    height, width = encoded.shape[:2]
+    padded = np.pad(encoded, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    window = [padded[dy:dy + height, dx:dx + width] for dy in range(3) for dx in range(3)]
+    brightest = np.max(window, axis=0)
+    flat = (brightest - np.min(window, axis=0)).max(axis=-1) <= np.float32(FLAT_SPAN)
+    return flat & (brightest.max(axis=-1) > np.float32(FLAT_SPAN))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_flat_pixels_by_running_extremes_are_the_stacked_ones(seed):
+    from aarecovery.spec.local_plan import flat_pixels
+    image = _drawn_and_noisy(seed)
+    np.testing.assert_array_equal(flat_pixels(image), _direct_flat_pixels(image))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_local_factor_at_some_pixels_is_the_whole_factor_there(seed):
+    from aarecovery.spec.local_plan import LocalStrength, ink_weight, ink_weight_at
+    image = _drawn_and_noisy(seed)
+    rows, cols = np.nonzero(np.random.default_rng(seed).random(image.shape[:2]) < 0.4)
+    assert ink_weight(image)[rows, cols].any()
+    np.testing.assert_array_equal(ink_weight_at(image, rows, cols), ink_weight(image)[rows, cols])
+    for local in (LocalStrength(0.25), LocalStrength(0.5, drawn_ink=False)):
+        np.testing.assert_array_equal(local.factor_at(image, rows, cols), local.factor(image)[rows, cols])

@@ -1,5 +1,7 @@
 """The strength control and the one-line summary of what a recovery did (API and commands)."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -173,3 +175,21 @@ def test_an_unsharp_masked_photo_is_not_offered_the_force():
 def test_a_repair_within_the_models_error_says_so():
     forcing = forcing_advice(Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT, ratio=1.19)
     assert not forcing.helps and "repair-to-error ratio 1.19" in forcing.why
+
+
+def test_the_summary_reads_the_window_the_plan_analysed(backend):
+    # Larger than the analysis window, with its edges in a corner: the window is chosen.
+    original, filtered = (np.zeros((700, 900, 3), np.uint8) for _ in range(2))
+    original[560:, 700:], filtered[560:, 700:] = edge_pair(140, 200, np.uint8)
+    with aarecovery.Engine(backend) as engine:
+        recovered = aarecovery.recover(original, filtered, engine=engine)
+        window = aarecovery.sample.array_window(original)
+        assert engine.last_plan.window == window != aarecovery.sample.analysis_windows(700, 900)[0]
+        engine.set_images(original, filtered)
+        assert engine.plan().window == window
+    summary = aarecovery.summarize_recovery(engine.last_plan, original, filtered, recovered)
+    chosen_again = aarecovery.summarize_recovery(dataclasses.replace(engine.last_plan, window=None), original,
+                                                 filtered, recovered)
+    assert summary.line() == chosen_again.line()
+    assert (summary.changed_pixels, summary.edge_share) == (chosen_again.changed_pixels, chosen_again.edge_share)
+    assert summary.changed_pixels > 0 and summary.edge_share > 0.05

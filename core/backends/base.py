@@ -90,6 +90,10 @@ class Plan:
     forcing : Forcing or None
         Where the safe default keeps F: whether forcing a repair may help, and why or what
         it risks (``aarecovery.plan.forcing``).
+    window : tuple of slice or None
+        The rows and columns of the pair that the safe default's analysis read
+        (``aarecovery.sample``), when the plan was made from the whole pair: the summary
+        reads the same window instead of choosing it again; None when unknown.
     """
 
     sigma_d: float
@@ -103,6 +107,7 @@ class Plan:
     decision: Decision = Decision.PAPER
     local: object = None
     forcing: object = None
+    window: tuple = None
 
     @property
     def keeps_filtered(self):

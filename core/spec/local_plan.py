@@ -59,7 +59,7 @@ import numpy as np
 from ..colour import linear_to_srgb
 
 __all__ = ["LocalStrength", "encoded_colour", "strength_map", "flat_pixels", "flat_share", "hard_edged_weight",
-           "ink_weight", "REACH", "REGION_RADIUS", "TEXTURED_SHARE", "HARD_EDGED_SHARE", "INK_RADIUS", "INK_REPEATS",
+           "ink_weight", "ink_weight_at", "REACH", "REGION_RADIUS", "TEXTURED_SHARE", "HARD_EDGED_SHARE", "INK_RADIUS", "INK_REPEATS",
            "INK_NEAR_SPAN", "INK_DARK", "INK_SHARE_LOW", "INK_SHARE_HIGH"]
 
 #: A pixel is flat when its 3 x 3 neighbourhood spans at most this in every channel: equal
@@ -100,13 +100,20 @@ def flat_pixels(encoded):
     """
     height, width = encoded.shape[:2]
     padded = np.pad(encoded, ((1, 1), (1, 1), (0, 0)), mode="edge")
-    window = [padded[dy:dy + height, dx:dx + width] for dy in range(3) for dx in range(3)]
-    brightest = np.max(window, axis=0)
-    flat = (brightest - np.min(window, axis=0)).max(axis=-1) <= np.float32(FLAT_SPAN)
+    # Running extremes, not np.max of the stacked 9 views: the same values without a
+    # (9, H, W, 3) copy (27 -> 10 ms on a 512 x 512 window).
+    brightest, darkest = padded[:height, :width].copy(), padded[:height, :width].copy()
+    for dy in range(3):
+        for dx in range(3):
+            np.maximum(brightest, padded[dy:dy + height, dx:dx + width], out=brightest)
+            np.minimum(darkest, padded[dy:dy + height, dx:dx + width], out=darkest)
+    span = brightest - darkest
+    flat = np.maximum(np.maximum(span[..., 0], span[..., 1]), span[..., 2]) <= np.float32(FLAT_SPAN)
     # Black is where a camera clips its shadows (a night sky, space): as often a photo's as
     # a drawing's ink, it is no evidence (held-out astronaut under a gamma curve: its photo
     # region went from 0.37 to -0.07 when it counted).
-    return flat & (brightest.max(axis=-1) > np.float32(FLAT_SPAN))
+    return flat & (np.maximum(np.maximum(brightest[..., 0], brightest[..., 1]), brightest[..., 2])
+                   > np.float32(FLAT_SPAN))
 
 
 def _shifted(image, radius, outside=None):
@@ -140,8 +147,52 @@ def ink_weight(encoded):
     """
     planes = np.ascontiguousarray(np.moveaxis(np.asarray(encoded, np.float32), -1, 0))
     extremes = _extremes(planes)
+    return _ink_weight(planes, extremes, _recurrences(planes, extremes))
+
+
+def ink_weight_at(encoded, rows, cols):
+    """float32 ``(K,)``: :func:`ink_weight` at the pixels ``(rows[k], cols[k])`` only, the
+    same values, reading only their neighbourhoods (the summary line reads it at a
+    window's edge pixels: 4% of the window on a photo, 5 ms against 90 ms).
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (H, W, 3)
+        O's sRGB-encoded colour (borders replicated).
+    rows, cols : ndarray of int, shape (K,)
+        The pixels.
+    """
+    encoded = np.asarray(encoded, np.float32)
+    rows, cols = np.asarray(rows, np.intp), np.asarray(cols, np.intp)
+    replicated = np.pad(encoded, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    # (9, K, 3), row by row as _extremes visits them; argmax and argmin take the first of
+    # equals, as its strict comparisons keep the first.
+    square = np.stack([replicated[rows + dy, cols + dx] for dy in range(3) for dx in range(3)])
+    brightness = square[..., 0] + square[..., 1] + square[..., 2]
+    picked = np.arange(rows.size)
+    extremes = tuple(np.ascontiguousarray(square[index, picked].T)
+                     for index in (brightness.argmax(axis=0), brightness.argmin(axis=0)))
+    radius = INK_RADIUS
+    outside = np.pad(encoded, ((radius, radius), (radius, radius), (0, 0)), constant_values=np.nan)
+    counts = [(np.zeros(rows.size, np.int32), np.zeros(rows.size, np.int32)) for _ in extremes]
+    for dy in range(2 * radius + 1):
+        for dx in range(2 * radius + 1):
+            colour = outside[rows + dy, cols + dx].T
+            for ink, (equal, near) in zip(extremes, counts):
+                distance = np.abs(colour[0] - ink[0])
+                for channel in (1, 2):
+                    np.maximum(distance, np.abs(colour[channel] - ink[channel]), out=distance)
+                same = distance <= np.float32(FLAT_SPAN)
+                equal += same
+                near += ~same & (distance <= np.float32(INK_NEAR_SPAN))
+    return _ink_weight(np.ascontiguousarray(encoded[rows, cols].T), extremes, counts)
+
+
+def _ink_weight(planes, extremes, recurrences):
+    """The weight from the pixels' colours `planes` ``(3, ...)``, their two extremes and
+    each extreme's recurrences (:func:`ink_weight`)."""
     weight = np.zeros(planes.shape[1:], np.float32)
-    for (ink, other), (equal, near) in zip((extremes, extremes[::-1]), _recurrences(planes, extremes)):
+    for (ink, other), (equal, near) in zip((extremes, extremes[::-1]), recurrences):
         drawn = (equal >= INK_REPEATS) & (2 * near <= equal) & (ink.max(axis=0) > np.float32(INK_DARK))
         span = np.sqrt(np.square(other - ink).sum(axis=0, dtype=np.float32))
         distance = np.sqrt(np.square(planes - ink).sum(axis=0, dtype=np.float32))
@@ -258,6 +309,25 @@ class LocalStrength:
         weight = hard_edged_weight(flat_share(encoded))
         if self.drawn_ink:
             weight = np.maximum(weight, ink_weight(encoded))
+        return self._from_weight(weight)
+
+    def factor_at(self, encoded, rows, cols):
+        """float32 ``(K,)``: :meth:`factor` at the pixels ``(rows[k], cols[k])`` of O only,
+        the same values (the drawn ink read only around them).
+
+        Parameters
+        ----------
+        encoded : ndarray of float32, shape (H, W, 3)
+            O's sRGB-encoded colour.
+        rows, cols : ndarray of int, shape (K,)
+            The pixels.
+        """
+        weight = hard_edged_weight(flat_share(encoded)[rows, cols])
+        if self.drawn_ink:
+            weight = np.maximum(weight, ink_weight_at(encoded, rows, cols))
+        return self._from_weight(weight)
+
+    def _from_weight(self, weight):
         return (np.float32(self.textured) + np.float32(1 - self.textured) * weight).astype(np.float32)
 
 
