@@ -89,8 +89,10 @@ _ANALYSIS_SIDE = 512
 # (bilateral); no strength was safe for all, so F is kept.
 _PHOTO_NEIGHBOURHOOD_STRENGTH = 0.0
 # Channels within this everywhere: a grey (or faintly tinted) image, whose colour lines cannot
-# tell the antialiasing space; the manga pages' cream paper differs by 3 levels.
-_NEAR_GREY = 4.0 / 255
+# tell the antialiasing space; the manga pages' cream paper differs by 3 levels, and by 5 once
+# saved as JPEG at q 95-98 (the chroma's rounding); the next least coloured family, a scanned
+# letter, by 22.
+_NEAR_GREY = 8.0 / 255
 
 
 @dataclass(frozen=True)
