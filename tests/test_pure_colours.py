@@ -186,3 +186,26 @@ def test_thin_features_are_not_extended_to_the_cube_when_f_is_straight_in_the_ke
         assert priors[name] is not None and priors[name].key in ("luma", "luminance", "luminance_d50", "channel")
     assert not priors["grey"].to_cube
     assert priors["threshold"].to_cube
+
+
+def test_a_jpegs_table_is_not_extrapolated_past_its_range():
+    # The star burst saved as a JPEG at q 75 (subsampled chroma: its thin spokes lose their
+    # colour) under OpenCV's gamma 2.2: extended to near white through the power law past the
+    # top of O's range, the spokes lost 3.0 dB against F on the tuning half; with the table
+    # flat past O's range, R gains.
+    from test_safeguards import family_as_jpeg
+
+    from aarecovery.lab.realtools import FAMILIES
+    from aarecovery.plan.resample import box_downsample
+    scene, clean, original = family_as_jpeg("starburst", 96, 75)
+    gamma = np.rint((np.arange(256) / 255.0) ** 2.2 * 255).astype(np.uint8)
+    filtered = gamma[original]
+    reference = box_downsample(gamma[scene].astype(np.float32) / 255, FAMILIES["starburst"].k, "srgb")
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(original, filtered)
+        plan = engine.plan()
+        assert plan.decision == aarecovery.Decision.POINTWISE_HARD_EDGED_COMPRESSED, plan.reason
+        assert plan.pure_colours is not None and plan.pure_colours.to_cube
+        recovered = aarecovery.recover(original, filtered, engine=engine)
+    band = edge_band(clean.astype(np.float32) / 255, gamma[clean].astype(np.float32) / 255, reference)
+    assert error_reduction(recovered.astype(np.float32) / 255, filtered.astype(np.float32) / 255, reference, band) > 0

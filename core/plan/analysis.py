@@ -16,7 +16,7 @@ colour lines better), then takes the first of these exits that applies, each nam
    ``F = f(O)`` for a fitted table on hard-edged content whose O was JPEG-compressed (its
    file's tables, or the block grid in its pixels): the calibrated strength, since the
    compression noise goes through the filter too, and the pure colours of thin features
-   only between extremes farther apart than that noise.
+   only between extremes farther apart than that noise, with the table flat past O's range.
    ``POINTWISE_HARD_EDGED_GRAINED`` (``paper_grain``): the same where O is a page with a
    coarse paper grain and no flat pixel, which goes through the filter like that noise.
 4. ``POINTWISE_HARD_EDGED``: the same on uncompressed hard-edged content: full strength
@@ -89,8 +89,10 @@ _ANALYSIS_SIDE = 512
 # (bilateral); no strength was safe for all, so F is kept.
 _PHOTO_NEIGHBOURHOOD_STRENGTH = 0.0
 # Channels within this everywhere: a grey (or faintly tinted) image, whose colour lines cannot
-# tell the antialiasing space; the manga pages' cream paper differs by 3 levels.
-_NEAR_GREY = 4.0 / 255
+# tell the antialiasing space; the manga pages' cream paper differs by 3 levels, and by 5 once
+# saved as JPEG at q 95-98 (the chroma's rounding); the next least coloured family, a scanned
+# letter, by 22.
+_NEAR_GREY = 8.0 / 255
 
 
 @dataclass(frozen=True)
@@ -211,7 +213,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # thin feature: pure colours only between extremes farther apart than both.
         grain = paper_grain(o)
         prior = pure_colour_prior(o, transfer, space, f, edges,
-                                  noise_contrast=max(compression.contrast, grain.contrast))
+                                  noise_contrast=max(compression.contrast, grain.contrast),
+                                  extend_ends=not compression.compressed)
         thin = ", pure colours of thin features" if prior is not None else ""
         if compression.compressed or grain.coarse:
             # A JPEG's noise goes through the filter too (a levels curve doubles it): full
