@@ -281,7 +281,9 @@ class LocalStrength:
     ----------
     textured : float
         The factor in textured regions: the calibrated strength for a photo, in (0, 1); a
-        fixed strength for hatching and screentone under a smoothing filter (``aarecovery.plan.hatching``).
+        fixed strength for hatching and screentone under a smoothing filter (``aarecovery.plan.hatching``);
+        0 for a photo under a neighbourhood filter, kept as F around the drawn regions
+        (``aarecovery.plan.mixed_content``).
     textured_regions : str
         What the textured regions are, for the summary line.
     drawn_ink : bool

@@ -1,0 +1,56 @@
+"""Text and drawings over a photo under a neighbourhood filter: repair the drawing, keep the photo.
+
+A filter that is neither point-wise nor a colour map (an unsharp mask, a bilateral or
+edge-preserving smoothing) cannot be simulated, so on a photo F is kept: the model would
+flatten its texture. A poster, a slide or a screenshot is a photo with text, logos and
+interface chrome drawn over it, and the drawn part is hard-edged content, which such
+filters damage and the model repairs (``analysis``'s neighbourhood branch for drawings).
+The local plan (``aarecovery.spec.local_plan``) tells the two apart per pixel; with a
+textured strength of 0 it keeps F in the photo and repairs where O is drawn.
+
+Whether a textured window holds drawn content at all is read from the same evidence: the
+share of its edge pixels whose local factor reads as drawn. Measured on the real-tools
+suite's tuning half, every case that kept F under a neighbourhood filter (113): the mixed
+scenes with PNG originals 0.21 (poster) and 0.27 (screenshot); every photo, drawing read
+as textured and JPEG original (whose compression leaves no exactly flat pixel) at most
+0.025 (the camera photo 0.024, serif as JPEG 0.025). At :data:`MIXED_DRAWN_SHARE`, tuning half: the ten mixed cases under the five
+neighbourhood filters gained 0.05-0.26 of their edge error (kept F before), their text and
+graphics 0.15-0.32, their photo regions -0.009 to +0.02 (within 0.04 dB of F); no other case
+moved; every mixed case's text and graphics 0.276 -> 0.339, whole edge band 0.251 -> 0.290.
+Held out (not used to choose): text and graphics 0.286 -> 0.333, whole band 0.232 -> 0.260,
+the banner's photo regions -0.013 to +0.0003, and the plots as high-quality JPEGs, whose
+flat areas survive, gained 0.002-0.165; no case lost.
+"""
+
+import numpy as np
+
+from ..spec.local_plan import LocalStrength
+
+__all__ = ["drawn_share", "MIXED_DRAWN_SHARE"]
+
+#: The share of a textured window's edge pixels that must read as drawn for its drawn
+#: regions to be repaired under a neighbourhood filter (F kept in the photo): between the
+#: tuning half's photos (at most 0.025) and its mixed scenes (0.21 and more).
+MIXED_DRAWN_SHARE = 0.1
+
+
+def drawn_share(encoded, edges):
+    """The share of the edge pixels that the local plan reads as drawn (text, graphics, ink).
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (H, W, 3)
+        O's sRGB-encoded colour (the analysis window).
+    edges : ndarray of bool, shape (H, W)
+
+    Returns
+    -------
+    float
+        0 without edge pixels.
+    """
+    rows, cols = np.nonzero(edges)
+    if rows.size == 0:
+        return 0.0
+    # With a textured strength of 0 the factor is the weight itself: drawn above one half,
+    # the same cut as the summary line's share of text and drawings.
+    return float((LocalStrength(0.0).factor_at(encoded, rows, cols) > 0.5).mean())
