@@ -187,3 +187,20 @@ def test_summary_prints_regions_haze_and_neighbourhood_filters():
         assert line in table, line
     assert "banner " in table.split("== mixed content per family")[1]
     assert "im-threshold-55 " in table.split("== scans: haze per filter")[1]
+
+
+def test_the_mixed_summary_says_by_how_much_the_worst_region_is_worse():
+    from aarecovery.lab.realeval import RealCaseResult, summarize_mixed
+
+    def case(name, photo):
+        result = RealCaseResult("banner", "linear", name, "mixed", 0.1)
+        result.psnr_band, result.reduction = {"F": 20.0, "R": 21.0, "paper": 21.0}, {"R": 0.3, "paper": 0.2}
+        result.region_error = {"text/graphics": 1e-3, "photo": 1e-3}
+        result.region_reduction = {"text/graphics": {"R": 0.4, "paper": 0.5}, "photo": {"R": photo, "paper": -1.0}}
+        return result
+
+    means, cases, worse, worst_db = summarize_mixed([case("a", 0.2), case("b", -0.01), case("c", -0.1)])["photo"]
+    assert cases == 3 and len(worse) == 2 and means["R"] == pytest.approx(0.03)
+    # MSE(R) = 1.1 MSE(F) in the worst: 0.41 dB.
+    assert worst_db == pytest.approx(10 * np.log10(1.1))
+    assert summarize_mixed([case("a", 0.2)])["photo"][2:] == ([], 0.0)

@@ -312,10 +312,11 @@ def summarize_mixed(results):
     Returns
     -------
     dict
-        Per region of :data:`REGIONS`: ``(means, cases, worse)``, the mean reduction per
-        method over the cases where F has an error in that region, their number, and the
-        cases where R is worse than F there (reduction below 0); ``"overall"``: ``(means,
-        cases)`` over the whole edge band.
+        Per region of :data:`REGIONS`: ``(means, cases, worse, worst_db)``, the mean
+        reduction per method over the cases where F has an error in that region, their
+        number, the cases where R is worse than F there (reduction below 0), and by how much
+        R is worse than F in the worst of them, in dB of the region's MSE (0 when none is);
+        ``"overall"``: ``(means, cases)`` over the whole edge band.
     """
     summary = {}
     for region in REGIONS:
@@ -323,7 +324,9 @@ def summarize_mixed(results):
         methods = [m for m in METHODS[1:] if picked and all(m in r.region_reduction[region] for r in picked)]
         means = {m: _mean(r.region_reduction[region][m] for r in picked) for m in methods}
         worse = [r.name for r in picked if r.region_reduction[region]["R"] < 0]
-        summary[region] = (means, len(picked), worse)
+        least = min((r.region_reduction[region]["R"] for r in picked), default=0.0)
+        # MSE(R) / MSE(F) = 1 - reduction: the loss in dB where it is above 1.
+        summary[region] = (means, len(picked), worse, max(0.0, float(10 * np.log10(1 - least))))
     summary["overall"] = mean_reductions(results)
     return summary
 

@@ -162,7 +162,8 @@ def _region_rows(summary, others, met):
                      _reduction(text[0].get("R", np.nan)).strip(), others(text[0]), f"{MIN_TEXT_REDUCTION}",
                      met(text[0].get("R", -np.inf) >= MIN_TEXT_REDUCTION)))
         rows.append((f"6. mixed content under {which}: photo regions worse than F ({photo[1]} cases)",
-                     f"{len(photo[2])} (mean {_reduction(photo[0].get('R', np.nan)).strip()})", others(photo[0]),
+                     f"{len(photo[2])} (mean {_reduction(photo[0].get('R', np.nan)).strip()}"
+                     + (f"; worst {photo[3]:.2f} dB)" if photo[2] else ")"), others(photo[0]),
                      "0", met(not photo[2])))
         overall, cases = mixed["overall"]
         rows.append((f"6. mixed content under {which}: whole edge band ({cases} cases)",
@@ -227,7 +228,7 @@ def _mixed_target_lines(mixed, which):
             f"mixed content under {which}, photo regions' edge band ({photo[1]} cases): R "
             f"{_reduction(photo[0].get('R', np.nan)).strip()} ({_means(photo[0], ('R',))}); target: at least "
             f"the calibrated strength of today's plan, no region worse than F: {len(photo[2])} cases worse"
-            + (f" ({', '.join(photo[2][:4])})" if photo[2] else ""),
+            + (f", the worst by {photo[3]:.2f} dB ({', '.join(photo[2][:4])})" if photo[2] else ""),
             f"mixed content under {which}, whole edge band ({cases} cases): R "
             f"{_reduction(overall.get('R', np.nan)).strip()} ({_means(overall, ('R',))}); target "
             f"{MIN_MIXED_REDUCTION}: {_verdict(overall.get('R', -np.inf) >= MIN_MIXED_REDUCTION)}"]
@@ -286,7 +287,7 @@ def _mixed_lines(results):
         summary = summarize_mixed([r for r in mixed if r.scene == family])
         cells = []
         for region in REGIONS:
-            means, count, _ = summary[region]
+            means, count = summary[region][:2]
             cells.append(f"{_reduction(means.get('R', np.nan)):>17s} {_reduction(means.get('paper', np.nan))} "
                          f"{count:3d}")
         overall = summary["overall"][0]
