@@ -153,6 +153,4 @@ def _hard_edged_share(plan, o_rgba, edges, linear):
     """The share of the window's edge pixels that the local plan repairs nearer full strength."""
     if plan.local is None or not edges.any():
         return None
-    rows, cols = np.nonzero(edges)
-    factor = plan.local.factor_at(encoded_colour(o_rgba, linear), rows, cols)
-    return float((factor > (1 + plan.local.textured) / 2).mean())
+    return plan.local.hard_edged_share(encoded_colour(o_rgba, linear), edges)

@@ -132,3 +132,13 @@ def test_the_local_factor_at_some_pixels_is_the_whole_factor_there(seed):
     np.testing.assert_array_equal(ink_weight_at(image, rows, cols), ink_weight(image)[rows, cols])
     for local in (LocalStrength(0.25), LocalStrength(0.5, drawn_ink=False)):
         np.testing.assert_array_equal(local.factor_at(image, rows, cols), local.factor(image)[rows, cols])
+
+
+def test_the_hard_edged_share_is_that_of_the_whole_factor_at_the_edges():
+    from aarecovery.spec.local_plan import LocalStrength
+    image = _drawn_and_noisy(5)
+    edges = np.random.default_rng(5).random(image.shape[:2]) < 0.3
+    for local in (LocalStrength(0.0), LocalStrength(0.4), LocalStrength(0.5, drawn_ink=False)):
+        expected = float((local.factor(image)[edges] > (1 + local.textured) / 2).mean())
+        assert local.hard_edged_share(image, edges) == expected
+    assert LocalStrength(0.3).hard_edged_share(image, np.zeros(edges.shape, bool)) == 0.0

@@ -73,8 +73,8 @@ from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
 from .hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screentone_drawing
 from .linearity import AFFINE_SHARE, affine_share
-from .mixed_content import MIXED_DRAWN_SHARE, drawn_share
 from .lowpass import fit_lowpass
+from .mixed_content import MIXED_DRAWN_SHARE, drawn_share
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
 from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, paper_grain
 from .pointwise import POINTWISE_SHARE, fit_pointwise

@@ -13,16 +13,15 @@ share of its edge pixels whose local factor reads as drawn. Measured on the real
 suite's tuning half, every case that kept F under a neighbourhood filter (113): the mixed
 scenes with PNG originals 0.21 (poster) and 0.27 (screenshot); every photo, drawing read
 as textured and JPEG original (whose compression leaves no exactly flat pixel) at most
-0.025 (the camera photo 0.024, serif as JPEG 0.025). At :data:`MIXED_DRAWN_SHARE`, tuning half: the ten mixed cases under the five
-neighbourhood filters gained 0.05-0.26 of their edge error (kept F before), their text and
-graphics 0.15-0.32, their photo regions -0.009 to +0.02 (within 0.04 dB of F); no other case
-moved; every mixed case's text and graphics 0.276 -> 0.339, whole edge band 0.251 -> 0.290.
+0.025 (the camera photo 0.024, serif as JPEG 0.025). At :data:`MIXED_DRAWN_SHARE`, tuning
+half: the ten mixed cases under the five neighbourhood filters gained 0.05-0.26 of their
+edge error (kept F before), their text and graphics 0.15-0.32, their photo regions -0.009 to
++0.02 (within 0.04 dB of F); no other case moved; every mixed case's text and graphics
+0.276 -> 0.339, whole edge band 0.251 -> 0.290.
 Held out (not used to choose): text and graphics 0.286 -> 0.333, whole band 0.232 -> 0.260,
 the banner's photo regions -0.013 to +0.0003, and the plots as high-quality JPEGs, whose
 flat areas survive, gained 0.002-0.165; no case lost.
 """
-
-import numpy as np
 
 from ..spec.local_plan import LocalStrength
 
@@ -48,9 +47,5 @@ def drawn_share(encoded, edges):
     float
         0 without edge pixels.
     """
-    rows, cols = np.nonzero(edges)
-    if rows.size == 0:
-        return 0.0
-    # With a textured strength of 0 the factor is the weight itself: drawn above one half,
-    # the same cut as the summary line's share of text and drawings.
-    return float((LocalStrength(0.0).factor_at(encoded, rows, cols) > 0.5).mean())
+    # The summary line's share of text and drawings, with a textured strength of 0.
+    return LocalStrength(0.0).hard_edged_share(encoded, edges)

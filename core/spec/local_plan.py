@@ -59,7 +59,8 @@ import numpy as np
 from ..colour import linear_to_srgb
 
 __all__ = ["LocalStrength", "encoded_colour", "strength_map", "flat_pixels", "flat_share", "hard_edged_weight",
-           "ink_weight", "ink_weight_at", "REACH", "REGION_RADIUS", "TEXTURED_SHARE", "HARD_EDGED_SHARE", "INK_RADIUS", "INK_REPEATS",
+           "ink_weight", "ink_weight_at", "REACH", "REGION_RADIUS", "TEXTURED_SHARE", "HARD_EDGED_SHARE", "INK_RADIUS",
+           "INK_REPEATS",
            "INK_NEAR_SPAN", "INK_DARK", "INK_SHARE_LOW", "INK_SHARE_HIGH"]
 
 #: A pixel is flat when its 3 x 3 neighbourhood spans at most this in every channel: equal
@@ -328,6 +329,21 @@ class LocalStrength:
         if self.drawn_ink:
             weight = np.maximum(weight, ink_weight_at(encoded, rows, cols))
         return self._from_weight(weight)
+
+    def hard_edged_share(self, encoded, edges):
+        """The share of the `edges` pixels whose factor is nearer 1 (hard-edged: text,
+        drawings, ink) than :attr:`textured`; 0 without edge pixels.
+
+        Parameters
+        ----------
+        encoded : ndarray of float32, shape (H, W, 3)
+            O's sRGB-encoded colour.
+        edges : ndarray of bool, shape (H, W)
+        """
+        rows, cols = np.nonzero(edges)
+        if rows.size == 0:
+            return 0.0
+        return float((self.factor_at(encoded, rows, cols) > (1 + self.textured) / 2).mean())
 
     def _from_weight(self, weight):
         return (np.float32(self.textured) + np.float32(1 - self.textured) * weight).astype(np.float32)
