@@ -36,6 +36,7 @@ TWINS = {
     ("blend_model.glsl", "FAINT"): float(blend_model._FAINT),
     ("blend_model.glsl", "SPREAD_TIE"): float(blend_model.SPREAD_TIE),
     ("blend_model.glsl", "SPREAD_TIE_FLOOR"): float(blend_model.SPREAD_TIE_FLOOR),
+    ("blend_model.glsl", "UNTOUCHED_EXTREMES"): float(blend_model.UNTOUCHED_EXTREMES),
     ("classify_blocks.comp", "MARGIN"): blocks.MARGIN,
     ("classify_blocks.comp", "BLOCK_SIDE"): blocks.BLOCK_SIDE,
     ("classify_blocks.frag", "MARGIN"): blocks.MARGIN,

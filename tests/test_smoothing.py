@@ -2,6 +2,7 @@
 edge's damage away as the reference does; a sharpening filter keeps full strength."""
 
 import numpy as np
+import pytest
 
 import aarecovery
 from aarecovery import Decision
@@ -11,6 +12,7 @@ from aarecovery.lab.metrics import edge_band, error_reduction
 from aarecovery.plan.calibration import EDGE_GRADIENT
 from aarecovery.plan.smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, contrast_ratio
 from aarecovery.spec.sobel import gradient_magnitude
+from parity import assert_maps_agree, assert_results_agree
 
 
 def _shapes(filter_name):
@@ -60,3 +62,77 @@ def test_a_smoothed_jpeg_drawing_is_repaired_at_a_lower_strength_and_not_made_wo
     plan = recover_no_worse_than_f(case)
     assert plan.decision == Decision.NEIGHBOURHOOD_HARD_EDGED and plan.pure_colours is None, plan.reason
     assert plan.strength == COMPRESSED_SMOOTHED_STRENGTH, plan.reason
+
+
+def test_a_smoothing_filter_keeps_f_where_it_left_o_as_it_was():
+    """Under a smoothing filter the confidence falls to 0 where F's pixel and its model's
+    extremes are O's: a pair whose left half F left as O had it is repaired on its right half
+    only, and the model's beta is the plain one where F changed by the span or more."""
+    from aarecovery.plan.smoothing import UNTOUCHED_SPAN
+    from aarecovery.spec import fit_blend_model, to_working_space
+    case = _shapes("bilateral")
+    filtered = case.filtered.copy()
+    half = filtered.shape[1] // 2
+    filtered[:, :half] = case.original[:, :half]
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, filtered)
+        plan = engine.plan()
+        assert plan.untouched_span == UNTOUCHED_SPAN, plan.reason
+        engine.run(plan, maps=True)
+        result, maps = engine.result(), engine.maps()
+    assert (maps.beta[:, :half - 1] == 0).all() and (maps.beta[:, half:] > 0.1).any()
+    np.testing.assert_array_equal(result[:, :half - 2], filtered[:, :half - 2])
+    # Where F moved by the span or more the factor is 1: beta as without it.
+    rgba = [to_working_space(np.concatenate([x, np.ones(x.shape[:2] + (1,), np.float32)], -1))
+            for x in (case.original, case.filtered)]
+    plain = fit_blend_model(*rgba, plan.sigma_d, plan.sigma_e, plan.strength)
+    kept = fit_blend_model(*rgba, plan.sigma_d, plan.sigma_e, plan.strength, untouched_span=UNTOUCHED_SPAN)
+    moved = np.abs(rgba[1] - rgba[0]).max(axis=-1) >= UNTOUCHED_SPAN
+    np.testing.assert_array_equal(kept.beta[moved], plain.beta[moved])
+    assert (kept.beta[~moved] < plain.beta[~moved]).any() and (kept.beta <= plain.beta).all()
+
+
+def test_a_colour_swapped_beside_an_untouched_blend_is_still_repaired():
+    """A colour replacement leaves the blend between a swapped colour and the paper as O had
+    it, which is its damage: where F moved an extreme by more than UNTOUCHED_EXTREMES the
+    factor is 1."""
+    from aarecovery.spec.blend_model import UNTOUCHED_EXTREMES, untouched_factor
+    original = np.ones((3, 3, 4), np.float32)
+    original[:, 0, :3] = (0.8, 0.1, 0.1)
+    original[:, 1, :3] = (0.9, 0.55, 0.55)
+    left, right = np.full((3, 3), 2, np.uint8), np.full((3, 3), 3, np.uint8)  # NEIGHBOUR_OFFSETS
+    swapped = original.copy()
+    swapped[:, 0, :3] = (0.1, 0.1, 0.8)
+    assert np.abs(swapped - original).max() > UNTOUCHED_EXTREMES
+    assert untouched_factor(original, swapped, left, right, 6.0 / 255)[1, 1] == 1
+    nudged = original.copy()
+    nudged[:, 0, :3] += np.float32(0.05)
+    assert untouched_factor(original, nudged, left, right, 6.0 / 255)[1, 1] == 0
+    nudged[1, 1, 0] += np.float32(3.0 / 255)
+    assert abs(untouched_factor(original, nudged, left, right, 6.0 / 255)[1, 1] - 0.5) < 1e-3  # halfway
+
+
+def test_a_sharpening_filter_and_the_paper_take_no_untouched_span():
+    case = _shapes("unsharp")
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        assert engine.plan().untouched_span == 0
+        engine.set_images(case.original, _shapes("bilateral").filtered)
+        assert engine.plan().untouched_span > 0
+        assert engine.plan(mode="paper").untouched_span == 0
+        assert engine.plan(strength=0.5).untouched_span == 0
+
+
+@pytest.mark.gl
+def test_gl_keeps_f_where_a_smoothing_filter_left_o_as_numpy_does(gl_path):
+    case = _shapes("bilateral")
+    filtered = case.filtered.copy()
+    filtered[:, :filtered.shape[1] // 2] = case.original[:, :filtered.shape[1] // 2]
+    results = {}
+    for backend in ("numpy", "gl"):
+        with aarecovery.Engine(backend, gl_path=gl_path if backend == "gl" else "auto") as engine:
+            results[backend] = aarecovery.recover(case.original, filtered, engine=engine, return_maps=True)
+            assert engine.last_plan.untouched_span > 0, engine.last_plan.reason
+    (numpy_result, numpy_maps), (gl_result, gl_maps) = results["numpy"], results["gl"]
+    assert_maps_agree(gl_maps, numpy_maps)
+    assert_results_agree(gl_result, numpy_result)

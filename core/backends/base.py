@@ -90,6 +90,10 @@ class Plan:
     local : LocalStrength or None
         The local plan (``aarecovery.spec.local_plan``): a per-pixel factor of ``beta``, read
         from O, on top of `strength`; None: `strength` alone, everywhere.
+    untouched_span : float
+        Above 0 (a smoothing filter, ``aarecovery.plan.smoothing``), ``beta`` falls to 0 where
+        F's pixel is O's: the model's pass multiplies it by a smoothstep of F's change from O
+        up to this (working space); 0, the paper's, leaves it as it is.
     forcing : Forcing or None
         Where the safe default keeps F: whether forcing a repair may help, and why or what
         it risks (``aarecovery.plan.forcing``).
@@ -109,6 +113,7 @@ class Plan:
     reason: str = "the published method"
     decision: Decision = Decision.PAPER
     local: object = None
+    untouched_span: float = 0.0
     forcing: object = None
     window: tuple = None
 

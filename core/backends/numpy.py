@@ -26,7 +26,7 @@ def _recover_in_strips(original, filtered, plan, factor):
         start, stop = max(0, top - halo), min(height, bottom + halo)
         result, model = recover_working(original[start:stop], filtered[start:stop], plan.sigma_d, plan.sigma_e,
                                         plan.iterations, plan.strength, plan.pure_colours, plan.blend_space,
-                                        None if factor is None else factor[start:stop])
+                                        None if factor is None else factor[start:stop], plan.untouched_span)
         inner = slice(top - start, top - start + bottom - top)
         recovered[top:bottom] = result[inner]
         columns.append([getattr(model, name)[inner] for name in BlendModel.MAP_FIELDS])

@@ -53,12 +53,13 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
                            + ("" if asked is None else f"; strength {asked:g} as asked"), decision=Decision.PAPER)
     if analysis is None:
         analysis = analyse_pair(original, filtered, linear, quantization)
-    # A strength the user gives overrides the analysis's, and its local plan, and forces a
-    # repair where it keeps F; the other decisions (blend space, pure colours) stand.
+    # A strength the user gives overrides the analysis's, its local plan and its untouched
+    # span (both per-pixel readings of the strength), and forces a repair where it keeps F;
+    # the other decisions (blend space, pure colours) stand.
     # A coarse paper grain raises the edge-strength scale (plan/paper_grain.py).
     common["sigma_e"] = parameters.sigma_e * analysis.edge_scale
     return Plan(**common, blend_space=blend_space or analysis.blend_space,
                 strength=analysis.strength if asked is None else asked, pure_colours=analysis.pure_colours,
                 mode="safe", decision=analysis.decision, local=analysis.local if asked is None else None,
-                forcing=analysis.forcing,
+                untouched_span=analysis.untouched_span if asked is None else 0.0, forcing=analysis.forcing,
                 reason=analysis.reason + ("" if asked is None else f"; strength {asked:g} as asked instead"))

@@ -41,7 +41,8 @@ colour lines better), then takes the first of these exits that applies, each nam
    repairs are no larger than the model's own error (a stricter bar for a compressed O):
    F is kept.
 10. ``NEIGHBOURHOOD_HARD_EDGED``: a neighbourhood filter on hard-edged content: the paper's
-    passes at full strength (lower for a smoothing filter: ``smoothing``) and, where the
+    passes at full strength (lower for a smoothing filter, and none where it left O's pixel
+    as it was: ``smoothing``) and, where the
     filter keeps flat colours (sharpening, edge-aware smoothing), the pure colours of thin
     features with the identity as the table (``flat_colours``); on hatched or screentoned
     content under a smoothing filter (``hatching``) full strength in its flat regions only
@@ -79,7 +80,7 @@ from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
 from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, paper_grain
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import pure_colour_prior
-from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, contrast_ratio
+from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, UNTOUCHED_SPAN, contrast_ratio
 from .texture import is_textured
 
 __all__ = ["PairAnalysis", "analyse", "analyse_pair", "analysis_crop"]
@@ -97,6 +98,8 @@ _PHOTO_NEIGHBOURHOOD_STRENGTH = 0.0
 # saved as JPEG at q 95-98 (the chroma's rounding); the next least coloured family, a scanned
 # letter, by 22.
 _NEAR_GREY = 8.0 / 255
+# The reasons' note of a smoothing filter's untouched edges (plan/smoothing.py).
+_UNTOUCHED = ", F kept where it left O's edges as they were"
 
 
 @dataclass(frozen=True)
@@ -123,6 +126,9 @@ class PairAnalysis:
     edge_scale : float
         Multiplies the edge-strength scale ``sigma_e`` the passes run at: above 1 on a page
         with a coarse paper grain (``aarecovery.plan.paper_grain``), whose weak edges are grain.
+    untouched_span : float
+        Under a smoothing filter (``aarecovery.plan.smoothing``), the change of F from O below
+        which an edge pixel gets less confidence (0 where F is O); 0: not applied.
     """
 
     blend_space: str
@@ -133,6 +139,7 @@ class PairAnalysis:
     local: object = None
     forcing: object = None
     edge_scale: float = 1.0
+    untouched_span: float = 0.0
 
 
 def analysis_crop(image):
@@ -276,11 +283,13 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
             if drawn >= MIXED_DRAWN_SHARE:
                 ratio = _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e)
                 if ratio >= MIN_REPAIR_TO_ERROR:
-                    strength = SMOOTHED_STRENGTH if contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST else 1.0
+                    smoothing = contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST
+                    strength = SMOOTHED_STRENGTH if smoothing else 1.0
                     return PairAnalysis(space, strength,
                                         f"neighbourhood filter on a textured image ({texture}) with text or drawings "
                                         f"over it ({drawn:.2f} of the edges): strength {strength:g} there, F kept in "
-                                        "the rest", Decision.NEIGHBOURHOOD_MIXED, local=LocalStrength(0.0))
+                                        "the rest" + (_UNTOUCHED if smoothing else ""), Decision.NEIGHBOURHOOD_MIXED,
+                                        local=LocalStrength(0.0), untouched_span=UNTOUCHED_SPAN if smoothing else 0.0)
             return PairAnalysis(space, _PHOTO_NEIGHBOURHOOD_STRENGTH,
                                 f"neighbourhood filter on a textured image ({texture}): "
                                 f"strength {_PHOTO_NEIGHBOURHOOD_STRENGTH:g}", Decision.NEIGHBOURHOOD_TEXTURED_KEPT,
@@ -313,6 +322,9 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # A smoothing filter averages part of an edge's damage away, as the reference does
     # (plan/smoothing.py).
     smoothing = contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST
+    # It also leaves some edges as O had them (a bilateral filter's strong edges), and so does
+    # the reference: there the confidence falls to 0 (UNTOUCHED_SPAN, in the model's pass).
+    untouched = dict(untouched_span=UNTOUCHED_SPAN if smoothing else 0.0)
     # On a page with a coarse paper grain (plan/paper_grain.py) it spreads the grain as it
     # spreads a JPEG's noise, so the repair runs at the grain's sigma_e, at a lower strength
     # and without pure colours. Tuning half, notice under the three tuning smoothing filters
@@ -323,8 +335,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     if smoothing and grain.coarse:
         return PairAnalysis(space, GRAINED_NEIGHBOURHOOD_STRENGTH,
                             f"neighbourhood filter on hard-edged content (repair-to-error ratio {ratio:.1f}) that "
-                            f"smooths {grain.describe()}: strength {GRAINED_NEIGHBOURHOOD_STRENGTH:g}",
-                            Decision.NEIGHBOURHOOD_HARD_EDGED, edge_scale=grain.edge_scale)
+                            f"smooths {grain.describe()}: strength {GRAINED_NEIGHBOURHOOD_STRENGTH:g}" + _UNTOUCHED,
+                            Decision.NEIGHBOURHOOD_HARD_EDGED, edge_scale=grain.edge_scale, **untouched)
     # Filters that keep flat colours (sharpening, edge-aware smoothing): thin features get
     # their pure colours with the identity as the table (plan/flat_colours.py).
     prior, kept = flat_colour_prior(o, f, edges)
@@ -336,20 +348,22 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     hatched = hatched_share(o, edges)
     if smoothing and hatched >= HATCHED_SHARE:
         return PairAnalysis(space, 1.0, why + f": full strength in flat regions, {HATCHED_STRENGTH:g} in the "
-                                              f"hatching or screentone around {hatched:.2f} of the edges" + pure,
-                            Decision.NEIGHBOURHOOD_HARD_EDGED, prior,
-                            local=LocalStrength(HATCHED_STRENGTH, "hatching and screentone", drawn_ink=False))
+                                              f"hatching or screentone around {hatched:.2f} of the edges" + pure
+                            + _UNTOUCHED, Decision.NEIGHBOURHOOD_HARD_EDGED, prior,
+                            local=LocalStrength(HATCHED_STRENGTH, "hatching and screentone", drawn_ink=False),
+                            **untouched)
     # A JPEG's noise goes through a smoothing filter too, spread over the edges: the repair
     # at a lower strength, without pure colours (see COMPRESSED_SMOOTHED_STRENGTH).
     if smoothing and compression.compressed:
         return PairAnalysis(space, COMPRESSED_SMOOTHED_STRENGTH,
                             why + f": a smoothing filter above {compression.describe()}, strength "
-                                  f"{COMPRESSED_SMOOTHED_STRENGTH:g}", Decision.NEIGHBOURHOOD_HARD_EDGED)
+                                  f"{COMPRESSED_SMOOTHED_STRENGTH:g}" + _UNTOUCHED, Decision.NEIGHBOURHOOD_HARD_EDGED,
+                            **untouched)
     # Only a filter that keeps O's flat colours and colour lines (the prior) is smoothing
     # edges: a conversion to grey lowers the luma contrast too (GIMP's desaturate).
     if smoothing and prior is not None:
         return PairAnalysis(space, SMOOTHED_STRENGTH, why + f": a smoothing filter, strength {SMOOTHED_STRENGTH:g}"
-                            + pure, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
+                            + pure + _UNTOUCHED, Decision.NEIGHBOURHOOD_HARD_EDGED, prior, **untouched)
     return PairAnalysis(space, 1.0, why + ": full strength" + pure, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
 
 

@@ -27,7 +27,7 @@ from .neighbourhood import dot, neighbours, planes
 from .sobel import sobel_magnitude
 
 __all__ = ["BlendModel", "edge_strength", "fit_paper_model", "principal_direction", "fit_extremes", "coverage",
-           "confidence"]
+           "confidence", "untouched_factor", "UNTOUCHED_EXTREMES"]
 
 _EM_ITERATIONS = 3
 _TINY = np.float32(1e-12)
@@ -41,6 +41,16 @@ _FAINT = np.float32(1e-30)
 SPREAD_TIE = np.float32(1e-3)
 #: The same tie for spreads too small for a relative margin: rounding of the mean is absolute.
 SPREAD_TIE_FLOOR = np.float32(1e-6)
+#: :func:`untouched_factor` applies only where F moved both extremes of the pixel's model by
+#: at most this (largest working-space channel): a smoothing filter moves them by a few levels,
+#: a colour replacement (the built-in suite's, read as smoothing on drawings) swaps a hue
+#: there and leaves the blended pixel between them as O had it, which is its damage. Tuning
+#: half, PNG drawings under the three smoothing filters (30 cases, with UNTOUCHED_SPAN): 0.586
+#: without the factor, 0.585 at 0, 0.591 at 0.05, 0.600 at 0.1, 0.604 at 0.2 and above;
+#: built-in quick suite, its colour replacement on the five drawings read as smoothing: 0.770
+#: without the factor, 0.769 at 0.1, shapes in sRGB 0.879 -> 0.842 at 0.2, all five 0.185
+#: without the bound.
+UNTOUCHED_EXTREMES = 0.1
 
 
 @dataclass
@@ -259,3 +269,29 @@ def fit_paper_model(original, filtered, sigma_d, sigma_e, strength=1.0, only=Non
         index_a[fitted] = col_a
         index_b[fitted] = col_b
     return BlendModel(alpha, beta, index_a, index_b, residual, edge)
+
+
+def untouched_factor(original, filtered, index_a, index_b, untouched_span):
+    """float32 ``(H, W)``: the factor of ``beta`` where a smoothing filter left O's pixel as it was.
+
+    A smoothstep from 0 where F's pixel is O's to 1 where some channel (of the working space,
+    alpha included) changed by `untouched_span` or more (``aarecovery.plan.smoothing``), where
+    F moved both extremes of the pixel's model by at most :data:`UNTOUCHED_EXTREMES`; 1
+    elsewhere.
+
+    Parameters
+    ----------
+    original, filtered : ndarray of float32, shape (H, W, 4)
+        O and F in the working space.
+    index_a, index_b : ndarray of uint8, shape (H, W)
+        The model's extremes (:class:`BlendModel`).
+    untouched_span : float
+        Above 0.
+    """
+    change = np.abs(filtered - original).max(axis=-1)
+    near = np.stack(neighbours(change[None]))[:, 0]
+    moved = np.maximum(np.take_along_axis(near, index_a[None].astype(np.intp), 0)[0],
+                       np.take_along_axis(near, index_b[None].astype(np.intp), 0)[0])
+    t = np.clip(change / np.float32(untouched_span), 0, 1).astype(np.float32)
+    return np.where(moved <= UNTOUCHED_EXTREMES, t * t * (np.float32(3) - np.float32(2) * t),
+                    np.float32(1)).astype(np.float32)

@@ -14,7 +14,7 @@ Each function is one pass, and the GL backend has a shader pass of the same name
 
 import numpy as np
 
-from .blend_model import fit_paper_model
+from .blend_model import fit_paper_model, untouched_factor
 from .jacobi import jacobi_step
 from .pure_colours import fit_pure_colour_model
 from .working_space import from_working_space, to_working_space
@@ -23,7 +23,7 @@ __all__ = ["to_working_space", "fit_blend_model", "jacobi_step", "from_working_s
 
 
 def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=None, blend_space="linear",
-                    factor=None):
+                    factor=None, untouched_span=0.0):
     """Fit the two-colour blend model at every pixel of O (section 3.1) and its confidence.
 
     The GL pass of this name also writes the first Jacobi iterate, which it can form from
@@ -47,6 +47,10 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
     factor : ndarray of float32, shape (H, W), optional
         The local plan's per-pixel factor of ``beta`` (``aarecovery.spec.local_plan``),
         applied after `strength`; None leaves ``beta`` as it is.
+    untouched_span : float
+        Above 0, ``beta`` is multiplied last by
+        :func:`~aarecovery.spec.blend_model.untouched_factor` (a smoothing filter's untouched
+        edges, ``aarecovery.plan.smoothing``); 0 leaves it as it is.
 
     Returns
     -------
@@ -58,11 +62,14 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
         model = fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space)
     if factor is not None:
         model.beta = (model.beta * factor).astype(np.float32)
+    if untouched_span > 0:
+        model.beta = (model.beta * untouched_factor(original, filtered, model.index_a, model.index_b,
+                                                    untouched_span)).astype(np.float32)
     return model
 
 
 def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1.0, prior=None,
-                    blend_space="linear", factor=None):
+                    blend_space="linear", factor=None, untouched_span=0.0):
     """Fit the model and run the Jacobi iterations on working-space images.
 
     Parameters are those of :func:`fit_blend_model`, and `iterations` (0 returns F).
@@ -72,7 +79,8 @@ def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1
     recovered : ndarray of float32, shape (H, W, 4)
     model : BlendModel
     """
-    model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, factor)
+    model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, factor,
+                            untouched_span)
     recovered = filtered
     for _ in range(iterations):
         recovered = jacobi_step(recovered, filtered, model)

@@ -341,7 +341,8 @@ class GLBackend:
         original_work, filtered_work = self._working_textures()
         sources = {"original_work": original_work, "filtered_work": filtered_work,
                    "filtered_image": self._textures["filtered"]}
-        uniforms = {"sigma_d": plan.sigma_d, "sigma_e": plan.sigma_e, "strength": plan.strength}
+        uniforms = {"sigma_d": plan.sigma_d, "sigma_e": plan.sigma_e, "strength": plan.strength,
+                    "untouched_span": plan.untouched_span}
         if prior is not None:
             sources["transfer_table"] = self._transfer_table(prior)
             uniforms.update(self._pure_colour_uniforms(prior))

@@ -6,6 +6,10 @@
 uniform float sigma_d;
 uniform float sigma_e;
 uniform float strength;  // the safe default's per-image repair strength; 1 for the paper
+// Above 0, beta falls to 0 where F's pixel is O's and F moved its extremes by at most
+// UNTOUCHED_EXTREMES (a smoothing filter's untouched edges, aarecovery.plan.smoothing): a
+// smoothstep of F's largest channel change up to this, last. Twin: untouched_factor.
+uniform float untouched_span;
 #if LOCAL_STRENGTH
 // The local plan's per-pixel factor of beta (aarecovery.spec.local_plan), after the strength.
 uniform sampler2D strength_factor;
@@ -15,6 +19,7 @@ const float TINY = 1e-12;
 const float FAINT = 1e-30;
 const float SPREAD_TIE = 1e-3;        // a start further by less is a tie: the first wins
 const float SPREAD_TIE_FLOOR = 1e-6;
+const float UNTOUCHED_EXTREMES = 0.1;  // F moved the extremes by at most this: untouched_factor applies
 
 struct BlendFit {
     vec4 model;           // alpha, beta, the extremes' offsets (+ 81, 162: pure colours), residual
@@ -121,6 +126,9 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
         vec4 filtered = f_b; f_b = f_a; f_a = filtered;
         ivec2 offset = offset_b; offset_b = offset_a; offset_a = offset;
     }
+    // F's change at the extremes, before pure colours replace their F (untouched_factor).
+    vec4 moved_ab = max(abs(f_a - c_a), abs(f_b - c_b));
+    float moved_extremes = max(max(moved_ab.r, moved_ab.g), max(moved_ab.b, moved_ab.a));
     vec4 span = c_a - c_b;
     float span_sq = dot(span, span);
     float alpha = span_sq > TINY ? clamp(dot(c[0] - c_b, span) / span_sq, 0.0, 1.0) : 0.5;
@@ -146,6 +154,11 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
 #if LOCAL_STRENGTH
     beta *= texelFetch(strength_factor, p, 0).r;
 #endif
+    if (untouched_span > 0.0 && moved_extremes <= UNTOUCHED_EXTREMES) {
+        vec4 moved = abs(f[0] - c[0]);
+        float t = clamp(max(max(moved.r, moved.g), max(moved.b, moved.a)) / untouched_span, 0.0, 1.0);
+        beta *= t * t * (3.0 - 2.0 * t);
+    }
     fit.model = vec4(alpha, beta, code, residual);
     fit.first_iterate = beta * (alpha * f_a + (1.0 - alpha) * f_b) + (1.0 - beta) * f[0];
 #if PURE_COLOURS
