@@ -142,3 +142,76 @@ def test_the_hard_edged_share_is_that_of_the_whole_factor_at_the_edges():
         expected = float((local.factor(image)[edges] > (1 + local.textured) / 2).mean())
         assert local.hard_edged_share(image, edges) == expected
     assert LocalStrength(0.3).hard_edged_share(image, np.zeros(edges.shape, bool)) == 0.0
+
+
+class _OneThread:
+    """An executor that runs each call at once, in the caller's thread."""
+
+    def __init__(self, *args, **kwargs):
+        pass
+
+    def submit(self, function, *args):
+        from concurrent.futures import Future
+
+        future = Future()
+        future.set_result(function(*args))
+        return future
+
+    def shutdown(self, **kwargs):
+        pass
+
+
+def _same(one, other):
+    """Equal analyses, arrays bit for bit (a dataclass's repr abbreviates its arrays)."""
+    if isinstance(one, np.ndarray) or isinstance(other, np.ndarray):
+        np.testing.assert_array_equal(one, other, strict=True)
+    elif hasattr(one, "__dict__") and not isinstance(one, type):
+        assert type(one) is type(other)
+        assert vars(one).keys() == vars(other).keys()
+        for name in vars(one):
+            _same(getattr(one, name), getattr(other, name))
+    elif hasattr(one, "__dataclass_fields__"):
+        for name in one.__dataclass_fields__:
+            _same(getattr(one, name), getattr(other, name))
+    else:
+        assert one == other
+
+
+def _analysed_pairs():
+    from jpeg_scans import scan_page
+
+    from aarecovery.filters import apply
+    from aarecovery.lab.bench import bench_image_pair
+    from aarecovery.lab.processes import thin_features_pair
+
+    photo = bench_image_pair(192, 160)
+    _, page, _ = scan_page(3, 80)
+    return {"thin features": thin_features_pair(200, 176), "photo-like": photo,
+            "blur": (photo[0], apply("blur", photo[0])), "jpeg page": (page, apply("threshold", page))}
+
+
+@pytest.mark.parametrize("name", ["thin features", "photo-like", "blur", "jpeg page"])
+def test_the_analysis_in_two_threads_with_one_blas_thread_is_the_sequential_one(name, monkeypatch):
+    from contextlib import nullcontext
+
+    from aarecovery.plan import analysis
+
+    original, filtered = _analysed_pairs()[name]
+    threaded = analysis.analyse_pair(original, filtered)
+    monkeypatch.setattr(analysis, "ThreadPoolExecutor", _OneThread)
+    monkeypatch.setattr(analysis, "one_blas_thread", nullcontext)
+    _same(threaded, analysis.analyse_pair(original, filtered))
+
+
+def test_one_blas_thread_limits_blas_inside_and_restores_it():
+    from threadpoolctl import threadpool_info
+
+    from aarecovery.plan.blas import one_blas_thread
+
+    def threads():
+        return [library["num_threads"] for library in threadpool_info() if library["user_api"] == "blas"]
+
+    before = threads()
+    with one_blas_thread():
+        assert set(threads()) <= {1}
+    assert threads() == before

@@ -1,0 +1,29 @@
+"""One BLAS thread while the plan runs.
+
+The plan's matrix products are small (8 x 8 DCTs, 3-channel colour weights, least squares
+of a few columns): OpenBLAS splits them over its threads, which then spin between calls
+and take a core from the plan's second thread (``aarecovery.plan.analysis``) and from
+anything else in the process. With one BLAS thread the products give the same figures
+(tests/test_exact_speedups.py) and the plan's CPU seconds equal its wall seconds
+(measured: docs/performance.md).
+"""
+
+from contextlib import contextmanager
+from functools import lru_cache
+
+__all__ = ["one_blas_thread"]
+
+
+@lru_cache(maxsize=1)
+def _controller():
+    # Finding the loaded BLAS libraries takes about 1 ms: once per process.
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()
+
+
+@contextmanager
+def one_blas_thread():
+    """Limit the BLAS libraries NumPy loaded to one thread inside the block."""
+    with _controller().limit(limits=1, user_api="blas"):
+        yield
