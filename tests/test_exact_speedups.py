@@ -215,3 +215,22 @@ def test_one_blas_thread_limits_blas_inside_and_restores_it():
     with one_blas_thread():
         assert set(threads()) <= {1}
     assert threads() == before
+
+
+@pytest.mark.parametrize("strength", [0.25, 0.5, 0.75, 0.375])
+def test_a_model_fitted_at_strength_one_and_scaled_is_the_fit_at_that_strength(strength):
+    import dataclasses
+
+    from aarecovery.lab.bench import bench_image_pair
+    from aarecovery.spec import fit_blend_model
+    from aarecovery.spec.blend_model import scaled_confidence
+
+    original, filtered = (to_working_space(np.concatenate([image / np.float32(255), np.ones(image.shape[:2] + (1,),
+                                                                                            np.float32)], -1)
+                                           .astype(np.float32), blend_space=space)
+                          for image, space in zip(bench_image_pair(96, 80, "gamma"), ("srgb", "srgb")))
+    once = fit_blend_model(original, filtered, SIGMA_D.default, SIGMA_E.default)
+    scaled = dataclasses.replace(once, beta=scaled_confidence(once.beta, strength))
+    direct = fit_blend_model(original, filtered, SIGMA_D.default, SIGMA_E.default, strength)
+    assert (direct.beta > 0).any()
+    _same(scaled, direct)
