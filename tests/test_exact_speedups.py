@@ -234,3 +234,22 @@ def test_a_model_fitted_at_strength_one_and_scaled_is_the_fit_at_that_strength(s
     direct = fit_blend_model(original, filtered, SIGMA_D.default, SIGMA_E.default, strength)
     assert (direct.beta > 0).any()
     _same(scaled, direct)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_flat_pixels_of_the_palette_by_running_extremes_are_those_of_the_nine_differences(seed):
+    from aarecovery.plan import pure_colours
+
+    rng = np.random.default_rng(seed)
+    # Flat patches of 8-bit colours, steps of exactly the tolerance and of one ulp around it.
+    base = np.repeat(np.repeat(rng.integers(0, 256, (12, 10, 3)), 4, 0), 4, 1) / np.float32(255)
+    step = np.float32(1 / 255) + rng.choice([-1, 0, 1], base.shape) * np.spacing(np.float32(1 / 255))
+    image = np.clip(base + rng.choice([-1, 0, 0, 0, 1], base.shape) * step, 0, 1).astype(np.float32)
+    height, width = image.shape[:2]
+    padded = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    direct = np.ones((height, width), bool)
+    for dy in range(3):
+        for dx in range(3):
+            direct &= largest_channel(np.abs(padded[dy:dy + height, dx:dx + width] - image)) <= 1 / 255
+    assert 0 < direct.sum() < direct.size
+    np.testing.assert_array_equal(pure_colours._flat(image), direct)
