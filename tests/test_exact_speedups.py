@@ -253,3 +253,17 @@ def test_flat_pixels_of_the_palette_by_running_extremes_are_those_of_the_nine_di
             direct &= largest_channel(np.abs(padded[dy:dy + height, dx:dx + width] - image)) <= 1 / 255
     assert 0 < direct.sum() < direct.size
     np.testing.assert_array_equal(pure_colours._flat(image), direct)
+
+
+def test_without_threadpoolctl_the_plan_runs_with_blas_as_it_is(monkeypatch):
+    import sys
+
+    from aarecovery.plan import blas
+
+    blas._controller.cache_clear()
+    monkeypatch.setitem(sys.modules, "threadpoolctl", None)
+    try:
+        with blas.one_blas_thread():
+            assert blas._controller() is None
+    finally:
+        blas._controller.cache_clear()

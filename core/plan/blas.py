@@ -8,7 +8,7 @@ anything else in the process. With one BLAS thread the products give the same fi
 (measured: docs/performance.md).
 """
 
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from functools import lru_cache
 
 __all__ = ["one_blas_thread"]
@@ -17,13 +17,18 @@ __all__ = ["one_blas_thread"]
 @lru_cache(maxsize=1)
 def _controller():
     # Finding the loaded BLAS libraries takes about 1 ms: once per process.
-    from threadpoolctl import ThreadpoolController
-
+    try:
+        from threadpoolctl import ThreadpoolController
+    except ImportError:
+        # A dependency of the package, but not of the GIMP and Krita plug-ins' bundles
+        # (NumPy and moderngl only): there BLAS keeps its threads, with the same results.
+        return None
     return ThreadpoolController()
 
 
 @contextmanager
 def one_blas_thread():
     """Limit the BLAS libraries NumPy loaded to one thread inside the block."""
-    with _controller().limit(limits=1, user_api="blas"):
+    controller = _controller()
+    with nullcontext() if controller is None else controller.limit(limits=1, user_api="blas"):
         yield
