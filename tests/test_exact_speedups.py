@@ -144,23 +144,6 @@ def test_the_hard_edged_share_is_that_of_the_whole_factor_at_the_edges():
     assert LocalStrength(0.3).hard_edged_share(image, np.zeros(edges.shape, bool)) == 0.0
 
 
-class _OneThread:
-    """An executor that runs each call at once, in the caller's thread."""
-
-    def __init__(self, *args, **kwargs):
-        pass
-
-    def submit(self, function, *args):
-        from concurrent.futures import Future
-
-        future = Future()
-        future.set_result(function(*args))
-        return future
-
-    def shutdown(self, **kwargs):
-        pass
-
-
 def _same(one, other):
     """Equal analyses, arrays bit for bit (a dataclass's repr abbreviates its arrays)."""
     if isinstance(one, np.ndarray) or isinstance(other, np.ndarray):
@@ -191,16 +174,16 @@ def _analysed_pairs():
 
 
 @pytest.mark.parametrize("name", ["thin features", "photo-like", "blur", "jpeg page"])
-def test_the_analysis_in_two_threads_with_one_blas_thread_is_the_sequential_one(name, monkeypatch):
+def test_the_plan_with_one_blas_thread_is_the_plan_with_blas_as_it_is(name, monkeypatch):
     from contextlib import nullcontext
 
-    from aarecovery.plan import analysis
+    import aarecovery.plan as plan_layer
+    from aarecovery.params import Parameters
 
     original, filtered = _analysed_pairs()[name]
-    threaded = analysis.analyse_pair(original, filtered)
-    monkeypatch.setattr(analysis, "ThreadPoolExecutor", _OneThread)
-    monkeypatch.setattr(analysis, "one_blas_thread", nullcontext)
-    _same(threaded, analysis.analyse_pair(original, filtered))
+    limited = plan_layer.make_plan(original, filtered, Parameters())
+    monkeypatch.setattr(plan_layer, "one_blas_thread", nullcontext)
+    _same(limited, plan_layer.make_plan(original, filtered, Parameters()))
 
 
 def test_one_blas_thread_limits_blas_inside_and_restores_it():

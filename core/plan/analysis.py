@@ -57,14 +57,12 @@ All of it runs once, in NumPy, on a central crop, before tiling, and results in 
 :class:`PairAnalysis` that ``aarecovery.plan.make_plan`` turns into the backends' Plan.
 """
 
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 from ..backends.base import Decision
 from ..colour import linear_to_srgb
 from ..contract import layout_of, to_rgba_float
 from ..params import ITERATIONS, SIGMA_D, SIGMA_E
-from .blas import one_blas_thread
 from ..spec.local_plan import LocalStrength
 from ..spec.sobel import gradient_magnitude
 from .blend_space import choose_blend_space
@@ -181,32 +179,12 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     """
     o_rgba = analysis_crop(original_rgba)
     f_rgba = analysis_crop(filtered_rgba)
+    space, residuals = choose_blend_space(o_rgba, linear_input)
     # The remaining analysis is on sRGB-encoded colour, as filters see it.
     o = o_rgba[..., :3] if not linear_input else linear_to_srgb(o_rgba[..., :3])
     f = f_rgba[..., :3] if not linear_input else linear_to_srgb(f_rgba[..., :3])
-    # What O alone tells (the blend space, its compression, its texture) is read in a second
-    # thread while this one compares F with O: the same calls on the same arrays, in two
-    # threads (NumPy releases the GIL in its loops), with one BLAS thread, whose spinning
-    # threads would otherwise take the second core. Measured on the 4096^2 pairs of
-    # ``aarecovery bench --process`` (2 cores): see docs/performance.md. An exit that needs
-    # none of it (F kept as a blur or an affine map) cancels what has not started.
-    pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="aarecovery-analysis")
-    try:
-        with one_blas_thread():
-            blend = pool.submit(choose_blend_space, o_rgba, linear_input)
-            compressing = pool.submit(compression_evidence, o, quantization)
-            texture = pool.submit(lambda: is_textured(o, blend.result()[1][blend.result()[0]], compressing.result()))
-            return _decide(o_rgba, f_rgba, o, f, linear_input, sigma_d, sigma_e, iterations, blend, compressing,
-                           texture)
-    finally:
-        pool.shutdown(wait=False, cancel_futures=True)
-
-
-def _decide(o_rgba, f_rgba, o, f, linear_input, sigma_d, sigma_e, iterations, blend, compressing, texture):
-    """:func:`analyse`'s exits in order; `blend`, `compressing` and `texture`: futures of
-    ``choose_blend_space``, ``compression_evidence`` and ``is_textured`` on O."""
+    fit = residuals[space]
     lowpass, kernel_residual, _ = fit_lowpass(o, f)
-    space, residuals = blend.result()
     if lowpass:
         return PairAnalysis(space, 0.0, f"F is a low-pass (blur) of O (kernel residual {kernel_residual:.3f}): kept F",
                             Decision.LOWPASS_KEPT, forcing=forcing_advice(Decision.LOWPASS_KEPT))
@@ -225,8 +203,8 @@ def _decide(o_rgba, f_rgba, o, f, linear_input, sigma_d, sigma_e, iterations, bl
                                             "edges, so its edges are already right: kept F", Decision.AFFINE_KEPT,
                                 forcing=forcing_advice(Decision.AFFINE_KEPT))
     transfer = fit_pointwise(o, f, edges)
-    compression = compressing.result()
-    textured, texture = texture.result()
+    compression = compression_evidence(o, quantization)
+    textured, texture = is_textured(o, fit, compression)
     if transfer.consistency >= POINTWISE_SHARE and not textured:
         # Hard-edged content: calibration would be biased here, since O is not a sharp
         # scene at twice the resolution (its edges are already blends) and box2(F) keeps

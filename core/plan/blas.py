@@ -1,11 +1,10 @@
 """One BLAS thread while the plan runs.
 
 The plan's matrix products are small (8 x 8 DCTs, 3-channel colour weights, least squares
-of a few columns): OpenBLAS splits them over its threads, which then spin between calls
-and take a core from the plan's second thread (``aarecovery.plan.analysis``) and from
-anything else in the process. With one BLAS thread the products give the same figures
-(tests/test_exact_speedups.py) and the plan's CPU seconds equal its wall seconds
-(measured: docs/performance.md).
+of a few columns): OpenBLAS splits them over its threads, which then spin between calls,
+taking a core from anything else on the machine for no gain in time. With one BLAS thread
+the products give the same figures (tests/test_exact_speedups.py) and the plan's CPU
+seconds equal its wall seconds (measured: docs/performance.md).
 """
 
 from contextlib import contextmanager, nullcontext
