@@ -198,6 +198,14 @@ def test_one_blas_thread_limits_blas_inside_and_restores_it():
     with one_blas_thread():
         assert set(threads()) <= {1}
     assert threads() == before
+    # Two threads' blocks that end in the other order than they began.
+    first, second = one_blas_thread(), one_blas_thread()
+    first.__enter__()
+    second.__enter__()
+    first.__exit__(None, None, None)
+    assert set(threads()) <= {1}
+    second.__exit__(None, None, None)
+    assert threads() == before
 
 
 @pytest.mark.parametrize("strength", [0.25, 0.5, 0.75, 0.375])

@@ -7,7 +7,8 @@ the products give the same figures (tests/test_exact_speedups.py) and the plan's
 seconds equal its wall seconds (measured: docs/performance.md).
 """
 
-from contextlib import contextmanager, nullcontext
+import threading
+from contextlib import contextmanager
 from functools import lru_cache
 
 __all__ = ["one_blas_thread"]
@@ -25,9 +26,31 @@ def _controller():
     return ThreadpoolController()
 
 
+# BLAS's thread count is the process's: plans made in several threads at once (an engine
+# per thread) share one limit, set by the first to enter and lifted by the last to leave, so
+# that crossed exits cannot leave the caller's BLAS at one thread.
+_lock = threading.Lock()
+_inside = 0
+_limit = None
+
+
 @contextmanager
 def one_blas_thread():
     """Limit the BLAS libraries NumPy loaded to one thread inside the block."""
+    global _inside, _limit
     controller = _controller()
-    with nullcontext() if controller is None else controller.limit(limits=1, user_api="blas"):
+    if controller is None:
         yield
+        return
+    with _lock:
+        if _inside == 0:
+            _limit = controller.limit(limits=1, user_api="blas")
+        _inside += 1
+    try:
+        yield
+    finally:
+        with _lock:
+            _inside -= 1
+            if _inside == 0:
+                _limit.restore_original_limits()
+                _limit = None
