@@ -26,6 +26,7 @@ import numpy as np
 
 from .colour import luma
 from .plan.analysis import analysis_crop
+from .plan.blas import one_blas_thread
 
 __all__ = ["analysis_sample", "array_sample", "array_window", "analysis_window", "analysis_windows"]
 
@@ -103,7 +104,10 @@ def analysis_window(read_original, height, width):
     windows = analysis_windows(height, width)
     if len(windows) == 1:
         return windows[0]
-    scores = [_edge_pixels(read_original(rows, cols)) for rows, cols in windows]
+    # Each window's luma is a matrix product: with BLAS's threads spinning between the 65 of
+    # a large image they cost CPU and no time (plan/blas.py).
+    with one_blas_thread():
+        scores = [_edge_pixels(read_original(rows, cols)) for rows, cols in windows]
     return windows[int(np.argmax(scores))]
 
 

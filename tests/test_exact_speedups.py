@@ -142,3 +142,119 @@ def test_the_hard_edged_share_is_that_of_the_whole_factor_at_the_edges():
         expected = float((local.factor(image)[edges] > (1 + local.textured) / 2).mean())
         assert local.hard_edged_share(image, edges) == expected
     assert LocalStrength(0.3).hard_edged_share(image, np.zeros(edges.shape, bool)) == 0.0
+
+
+def _same(one, other):
+    """Equal analyses, arrays bit for bit (a dataclass's repr abbreviates its arrays)."""
+    if isinstance(one, np.ndarray) or isinstance(other, np.ndarray):
+        np.testing.assert_array_equal(one, other, strict=True)
+    elif hasattr(one, "__dict__") and not isinstance(one, type):
+        assert type(one) is type(other)
+        assert vars(one).keys() == vars(other).keys()
+        for name in vars(one):
+            _same(getattr(one, name), getattr(other, name))
+    elif hasattr(one, "__dataclass_fields__"):
+        for name in one.__dataclass_fields__:
+            _same(getattr(one, name), getattr(other, name))
+    else:
+        assert one == other
+
+
+def _analysed_pairs():
+    from jpeg_scans import scan_page
+
+    from aarecovery.filters import apply
+    from aarecovery.lab.bench import bench_image_pair
+    from aarecovery.lab.processes import thin_features_pair
+
+    photo = bench_image_pair(192, 160)
+    _, page, _ = scan_page(3, 80)
+    return {"thin features": thin_features_pair(200, 176), "photo-like": photo,
+            "blur": (photo[0], apply("blur", photo[0])), "jpeg page": (page, apply("threshold", page))}
+
+
+@pytest.mark.parametrize("name", ["thin features", "photo-like", "blur", "jpeg page"])
+def test_the_plan_with_one_blas_thread_is_the_plan_with_blas_as_it_is(name, monkeypatch):
+    from contextlib import nullcontext
+
+    import aarecovery.plan as plan_layer
+    from aarecovery.params import Parameters
+
+    original, filtered = _analysed_pairs()[name]
+    limited = plan_layer.make_plan(original, filtered, Parameters())
+    monkeypatch.setattr(plan_layer, "one_blas_thread", nullcontext)
+    _same(limited, plan_layer.make_plan(original, filtered, Parameters()))
+
+
+def test_one_blas_thread_limits_blas_inside_and_restores_it():
+    from threadpoolctl import threadpool_info
+
+    from aarecovery.plan.blas import one_blas_thread
+
+    def threads():
+        return [library["num_threads"] for library in threadpool_info() if library["user_api"] == "blas"]
+
+    before = threads()
+    with one_blas_thread():
+        assert set(threads()) <= {1}
+    assert threads() == before
+    # Two threads' blocks that end in the other order than they began.
+    first, second = one_blas_thread(), one_blas_thread()
+    first.__enter__()
+    second.__enter__()
+    first.__exit__(None, None, None)
+    assert set(threads()) <= {1}
+    second.__exit__(None, None, None)
+    assert threads() == before
+
+
+@pytest.mark.parametrize("strength", [0.25, 0.5, 0.75, 0.375])
+def test_a_model_fitted_at_strength_one_and_scaled_is_the_fit_at_that_strength(strength):
+    import dataclasses
+
+    from aarecovery.lab.bench import bench_image_pair
+    from aarecovery.spec import fit_blend_model
+    from aarecovery.spec.blend_model import scaled_confidence
+
+    original, filtered = (to_working_space(np.concatenate([image / np.float32(255), np.ones(image.shape[:2] + (1,),
+                                                                                            np.float32)], -1)
+                                           .astype(np.float32), blend_space=space)
+                          for image, space in zip(bench_image_pair(96, 80, "gamma"), ("srgb", "srgb")))
+    once = fit_blend_model(original, filtered, SIGMA_D.default, SIGMA_E.default)
+    scaled = dataclasses.replace(once, beta=scaled_confidence(once.beta, strength))
+    direct = fit_blend_model(original, filtered, SIGMA_D.default, SIGMA_E.default, strength)
+    assert (direct.beta > 0).any()
+    _same(scaled, direct)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_flat_pixels_of_the_palette_by_running_extremes_are_those_of_the_nine_differences(seed):
+    from aarecovery.plan import pure_colours
+
+    rng = np.random.default_rng(seed)
+    # Flat patches of 8-bit colours, steps of exactly the tolerance and of one ulp around it.
+    base = np.repeat(np.repeat(rng.integers(0, 256, (12, 10, 3)), 4, 0), 4, 1) / np.float32(255)
+    step = np.float32(1 / 255) + rng.choice([-1, 0, 1], base.shape) * np.spacing(np.float32(1 / 255))
+    image = np.clip(base + rng.choice([-1, 0, 0, 0, 1], base.shape) * step, 0, 1).astype(np.float32)
+    height, width = image.shape[:2]
+    padded = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    direct = np.ones((height, width), bool)
+    for dy in range(3):
+        for dx in range(3):
+            direct &= largest_channel(np.abs(padded[dy:dy + height, dx:dx + width] - image)) <= 1 / 255
+    assert 0 < direct.sum() < direct.size
+    np.testing.assert_array_equal(pure_colours._flat(image), direct)
+
+
+def test_without_threadpoolctl_the_plan_runs_with_blas_as_it_is(monkeypatch):
+    import sys
+
+    from aarecovery.plan import blas
+
+    blas._controller.cache_clear()
+    monkeypatch.setitem(sys.modules, "threadpoolctl", None)
+    try:
+        with blas.one_blas_thread():
+            assert blas._controller() is None
+    finally:
+        blas._controller.cache_clear()

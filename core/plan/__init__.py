@@ -10,6 +10,7 @@ every backend take as it is.
 from ..backends.base import Decision, Plan
 from ..params import check_blend_space, check_mode
 from .analysis import PairAnalysis, analyse, analyse_pair
+from .blas import one_blas_thread
 
 __all__ = ["make_plan", "Decision", "Plan", "PairAnalysis", "analyse", "analyse_pair"]
 
@@ -52,7 +53,9 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
                     reason="the published method (Yang et al. 2011), without the safe default's analysis"
                            + ("" if asked is None else f"; strength {asked:g} as asked"), decision=Decision.PAPER)
     if analysis is None:
-        analysis = analyse_pair(original, filtered, linear, quantization)
+        # One BLAS thread (plan/blas.py): the same analysis, without spinning threads.
+        with one_blas_thread():
+            analysis = analyse_pair(original, filtered, linear, quantization)
     # A strength the user gives overrides the analysis's, its local plan and its untouched
     # span (both per-pixel readings of the strength), and forces a repair where it keeps F;
     # the other decisions (blend space, pure colours) stand.

@@ -172,24 +172,26 @@ def _scale_tables(original, filtered, key):
     index = np.clip((source_luma * _LUT_BINS).astype(np.intp), 0, _LUT_BINS - 1)
     centres = np.arange(_LUT_BINS)
 
-    def table(values, use, at_mean_key):
-        counts = np.bincount(index[use], minlength=_LUT_BINS)
-        sums = np.bincount(index[use], values[use], minlength=_LUT_BINS)
+    def tables(values, use):
+        # The bins' counts and sums once for both placements (they took 2 x 12 ms per key).
+        used = index[use]
+        counts = np.bincount(used, minlength=_LUT_BINS)
+        sums = np.bincount(used, values[use], minlength=_LUT_BINS)
         filled = counts > 0
+        means = sums[filled] / counts[filled]
         # Each bin's mean at its bin's centre, or at its pixels' mean key (a bin holding
         # black and a few dark blends is not centred).
-        where = (np.bincount(index[use], source_luma[use], minlength=_LUT_BINS)[filled] / counts[filled]
-                 * _LUT_BINS - 0.5 if at_mean_key else centres[filled])
-        column = np.interp(centres, where, sums[filled] / counts[filled]) if filled.any() else np.zeros(_LUT_BINS)
-        return np.repeat(column[:, None], 3, axis=1).astype(np.float32)
+        for where in (centres[filled], (np.bincount(used, source_luma[use], minlength=_LUT_BINS)[filled]
+                                        / counts[filled] * _LUT_BINS - 0.5)):
+            column = np.interp(centres, where, means) if filled.any() else np.zeros(_LUT_BINS)
+            yield np.repeat(column[:, None], 3, axis=1).astype(np.float32)
 
     own = result @ weights
     unclipped = largest_channel(result) < 1 - 1 / 512
     has_unclipped = np.bincount(index[unclipped], minlength=_LUT_BINS) > 0
     first = unclipped | ~has_unclipped[index]
     scaled, second = _scaled_luma(source, result, source_luma)
-    return tuple(table(values, use, at_mean_key) for values, use in ((own, first), (scaled, second))
-                 for at_mean_key in (False, True))
+    return tuple(table for values, use in ((own, first), (scaled, second)) for table in tables(values, use))
 
 
 def _scaled_luma(source, result, source_luma):

@@ -218,7 +218,14 @@ def confidence(residual, edge, sigma_d, sigma_e, strength):
     """Equation 5, ``beta = G(d_p, sigma_d) (1 - G(e_p, sigma_e))``, times `strength`."""
     residual_ratio = residual / np.float32(sigma_d)
     edge_ratio = edge / np.float32(sigma_e)
-    beta = np.exp(-residual_ratio * residual_ratio) * (1 - np.exp(-edge_ratio * edge_ratio))
+    return scaled_confidence(np.exp(-residual_ratio * residual_ratio) * (1 - np.exp(-edge_ratio * edge_ratio)),
+                             strength)
+
+
+def scaled_confidence(beta, strength):
+    """``beta`` times `strength` as :func:`confidence` applies it (1 leaves it bit-identical):
+    the model fitted at strength 1 gives any strength's ``beta`` exactly (the safe plan's
+    calibration fits once for all its strengths)."""
     if strength != 1.0:
         beta = beta * np.float32(strength)
     return beta.astype(np.float32)

@@ -69,18 +69,21 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
 
 
 def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1.0, prior=None,
-                    blend_space="linear", factor=None, untouched_span=0.0):
+                    blend_space="linear", factor=None, untouched_span=0.0, model=None):
     """Fit the model and run the Jacobi iterations on working-space images.
 
-    Parameters are those of :func:`fit_blend_model`, and `iterations` (0 returns F).
+    Parameters are those of :func:`fit_blend_model`, `iterations` (0 returns F) and `model`,
+    the model :func:`fit_blend_model` gives for them when the caller already has it (then
+    not fitted again).
 
     Returns
     -------
     recovered : ndarray of float32, shape (H, W, 4)
     model : BlendModel
     """
-    model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, factor,
-                            untouched_span)
+    if model is None:
+        model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, factor,
+                                untouched_span)
     recovered = filtered
     for _ in range(iterations):
         recovered = jacobi_step(recovered, filtered, model)
