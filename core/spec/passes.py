@@ -23,7 +23,7 @@ __all__ = ["to_working_space", "fit_blend_model", "jacobi_step", "from_working_s
 
 
 def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=None, blend_space="linear",
-                    factor=None):
+                    factor=None, gate=None):
     """Fit the two-colour blend model at every pixel of O (section 3.1) and its confidence.
 
     The GL pass of this name also writes the first Jacobi iterate, which it can form from
@@ -47,6 +47,9 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
     factor : ndarray of float32, shape (H, W), optional
         The local plan's per-pixel factor of ``beta`` (``aarecovery.spec.local_plan``),
         applied after `strength`; None leaves ``beta`` as it is.
+    gate : ndarray of float32, shape (H, W), optional
+        Where a `prior` that acts on drawn content only acts, from 0 to 1: the local plan's
+        weight of the drawn regions (``LocalStrength.region_weight``).
 
     Returns
     -------
@@ -55,14 +58,14 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
     if prior is None:
         model = fit_paper_model(original, filtered, sigma_d, sigma_e, strength)
     else:
-        model = fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space)
+        model = fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, gate)
     if factor is not None:
         model.beta = (model.beta * factor).astype(np.float32)
     return model
 
 
 def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1.0, prior=None,
-                    blend_space="linear", factor=None):
+                    blend_space="linear", factor=None, gate=None):
     """Fit the model and run the Jacobi iterations on working-space images.
 
     Parameters are those of :func:`fit_blend_model`, and `iterations` (0 returns F).
@@ -72,7 +75,7 @@ def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1
     recovered : ndarray of float32, shape (H, W, 4)
     model : BlendModel
     """
-    model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, factor)
+    model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, factor, gate)
     recovered = filtered
     for _ in range(iterations):
         recovered = jacobi_step(recovered, filtered, model)
