@@ -32,8 +32,9 @@ colour lines better), then takes the first of these exits that applies, each nam
    colour map of all three channels at once (``colour_map``): it cannot be simulated and
    the model would flatten the texture, F is kept. ``NEIGHBOURHOOD_MIXED``
    (``mixed_content``): the same where text or drawings cover part of the photo: they are
-   repaired as step 10 would (0.75 under a smoothing filter), F kept in the photo (the
-   local plan with a textured strength of 0).
+   repaired as step 10 would (0.75 under a smoothing filter; pure colours where the filter
+   keeps flat colours, in the drawn regions only), F kept in the photo (the local plan with
+   a textured strength of 0).
 7. ``COLOUR_MAP_KEPT``: a colour map on a textured image whose repairs are no larger than
    the model's own error carried through the filter (``model_error``): F is kept.
 8. ``COLOUR_MAP_CALIBRATED``: a colour map (a palette quantiser) on a textured image: the
@@ -295,10 +296,21 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                 ratio = _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e)
                 if ratio >= MIN_REPAIR_TO_ERROR:
                     strength = SMOOTHED_STRENGTH if contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST else 1.0
+                    # Where the filter keeps flat colours, thin features in the drawn regions
+                    # get their pure colours (plan/flat_colours.py), by the regions' weight as
+                    # for a point-wise filter: tuning half, the screenshot under the five
+                    # neighbourhood filters 0.145-0.261 -> 0.162-0.437 (text and graphics
+                    # +0.03 to +0.22), photo regions unchanged; the poster's filters keep no
+                    # flat colours there. Every filter's text and graphics 0.387 -> 0.402.
+                    prior, kept = flat_colour_prior(o, f, edges)
+                    if prior is not None:
+                        prior = dataclasses.replace(prior, drawn_only=True)
+                    pure = f", pure colours of thin features there ({kept})" if prior is not None else ""
                     return PairAnalysis(space, strength,
                                         f"neighbourhood filter on a textured image ({texture}) with text or drawings "
-                                        f"over it ({drawn:.2f} of the edges): strength {strength:g} there, F kept in "
-                                        "the rest", Decision.NEIGHBOURHOOD_MIXED, local=LocalStrength(0.0))
+                                        f"over it ({drawn:.2f} of the edges): strength {strength:g} there{pure}, F "
+                                        "kept in the rest", Decision.NEIGHBOURHOOD_MIXED, prior,
+                                        local=LocalStrength(0.0))
             return PairAnalysis(space, _PHOTO_NEIGHBOURHOOD_STRENGTH,
                                 f"neighbourhood filter on a textured image ({texture}): "
                                 f"strength {_PHOTO_NEIGHBOURHOOD_STRENGTH:g}", Decision.NEIGHBOURHOOD_TEXTURED_KEPT,
