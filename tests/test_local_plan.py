@@ -66,7 +66,8 @@ def test_the_repair_is_better_on_the_text_and_the_same_on_the_photo(banner_over_
         plan = engine.plan()
         engine.run(plan)
         local = engine.result()
-        engine.run(dataclasses.replace(plan, local=None, strength=plan.local.textured))
+        # One strength everywhere, as before the local plan (no pure colours on a photo).
+        engine.run(dataclasses.replace(plan, local=None, strength=plan.local.textured, pure_colours=None))
         one_strength = engine.result()
     band = edge_band(case.original, case.filtered, case.reference)
     text, photo = band.copy(), band.copy()

@@ -80,3 +80,45 @@ def test_gl_gives_the_numpy_result_with_the_photo_at_strength_0(poster, gl_path)
         actual = aarecovery.recover(*pair, engine=engine)
         assert engine.last_plan.decision == Decision.NEIGHBOURHOOD_MIXED
     assert_results_agree(actual, expected, gl_path)
+
+
+@pytest.fixture(scope="module")
+def screenshot():
+    """The tuning half's screenshot (interface chrome and text over a grey photo) at 96 px."""
+    scene, mask = render_scene("screenshot", 96)
+    k = FAMILIES["screenshot"].k
+    return scene, overlay_regions(mask, k), k
+
+
+def test_thin_features_in_the_drawn_regions_get_their_pure_colours(screenshot, gl_path):
+    """Where the filter keeps flat colours, the drawn regions' thin features get their pure
+    colours (the identity table, gated by the local plan's regions' weight); the photo stays F
+    (tuning half, screenshot under the five neighbourhood filters: text and graphics +0.03 to
+    +0.22, the photo regions unchanged)."""
+    import dataclasses
+
+    from parity import assert_results_agree
+
+    scene, regions, k = screenshot
+    case = make_case(scene, "unsharp", k, "linear")
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        plan = engine.plan()
+        assert plan.decision == Decision.NEIGHBOURHOOD_MIXED, plan.reason
+        assert plan.pure_colours is not None and plan.pure_colours.drawn_only
+        results = {}
+        for name, used in (("pure", plan), ("paper's passes", dataclasses.replace(plan, pure_colours=None))):
+            engine.run(used)
+            results[name] = engine.result()
+    band = edge_band(case.original, case.filtered, case.reference)
+    score = {name: [error_reduction(image[..., :3], case.filtered, case.reference, band & regions[region])
+                    for region in ("text/graphics", "photo")] for name, image in results.items()}
+    (drawn, photo), (drawn_before, photo_before) = score["pure"], score["paper's passes"]
+    assert drawn > drawn_before + 0.05, score
+    assert photo == pytest.approx(photo_before, abs=0.005), score
+    pair = tuple(np.rint(image * 255).astype(np.uint8) for image in (case.original, case.filtered))
+    expected = aarecovery.recover(*pair, backend="numpy")
+    with aarecovery.Engine("gl", gl_path=gl_path) as engine:
+        actual = aarecovery.recover(*pair, engine=engine)
+        assert engine.last_plan.pure_colours.drawn_only
+    assert_results_agree(actual, expected, gl_path)

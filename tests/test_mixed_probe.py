@@ -31,7 +31,8 @@ def test_the_local_plan_repairs_the_graphics_more_and_the_photo_as_much():
         assert plan.local is not None, plan.reason
         engine.run(plan)
         local = measure_regions(case, engine.result())
-        engine.run(dataclasses.replace(plan, local=None, strength=plan.local.textured))
+        # One strength everywhere, as before the local plan (no pure colours on a photo).
+        engine.run(dataclasses.replace(plan, local=None, strength=plan.local.textured, pure_colours=None))
         one_strength = measure_regions(case, engine.result())
     assert local["graphics"] > one_strength["graphics"] + 0.05, (local, one_strength)
     assert local["photo"] == pytest.approx(one_strength["photo"], abs=0.02) and local["photo"] > 0

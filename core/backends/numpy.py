@@ -16,7 +16,7 @@ __all__ = ["NumpyBackend"]
 _STRIP_ROWS = 64
 
 
-def _recover_in_strips(original, filtered, plan, factor):
+def _recover_in_strips(original, filtered, plan, factor, gate):
     height = original.shape[0]
     halo = halo_for(plan.iterations)
     recovered = np.empty_like(filtered)
@@ -26,7 +26,8 @@ def _recover_in_strips(original, filtered, plan, factor):
         start, stop = max(0, top - halo), min(height, bottom + halo)
         result, model = recover_working(original[start:stop], filtered[start:stop], plan.sigma_d, plan.sigma_e,
                                         plan.iterations, plan.strength, plan.pure_colours, plan.blend_space,
-                                        None if factor is None else factor[start:stop], plan.untouched_span)
+                                        None if factor is None else factor[start:stop], plan.untouched_span,
+                                        None if gate is None else gate[start:stop])
         inner = slice(top - start, top - start + bottom - top)
         recovered[top:bottom] = result[inner]
         columns.append([getattr(model, name)[inner] for name in BlendModel.MAP_FIELDS])
@@ -56,7 +57,11 @@ class NumpyBackend:
 
     def run(self, plan, maps):
         factor = None if plan.local is None else plan.local.factor(self._encoded)
-        recovered, model = _recover_in_strips(self._original, self._filtered, plan, factor)
+        # Pure colours that act on drawn content only are gated by the regions' weight.
+        gate = None
+        if factor is not None and plan.pure_colours is not None and plan.pure_colours.drawn_only:
+            gate = plan.local.region_weight(self._encoded)
+        recovered, model = _recover_in_strips(self._original, self._filtered, plan, factor, gate)
         self._result = from_working_space(recovered, self._filtered_rgba, filtered_work=self._filtered,
                                           **self._space)
         self._model = model

@@ -61,8 +61,13 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
     # the other decisions (blend space, pure colours) stand.
     # A coarse paper grain raises the edge-strength scale (plan/paper_grain.py).
     common["sigma_e"] = parameters.sigma_e * analysis.edge_scale
+    # Pure colours gated by the local plan (over a photo) go with it: without its weight they
+    # would act on the photo too.
+    prior = analysis.pure_colours
+    if asked is not None and prior is not None and prior.drawn_only:
+        prior = None
     return Plan(**common, blend_space=blend_space or analysis.blend_space,
-                strength=analysis.strength if asked is None else asked, pure_colours=analysis.pure_colours,
+                strength=analysis.strength if asked is None else asked, pure_colours=prior,
                 mode="safe", decision=analysis.decision, local=analysis.local if asked is None else None,
                 untouched_span=analysis.untouched_span if asked is None else 0.0, forcing=analysis.forcing,
                 reason=analysis.reason + ("" if asked is None else f"; strength {asked:g} as asked instead"))

@@ -21,6 +21,10 @@ edge error (kept F before), their text and graphics 0.15-0.32, their photo regio
 Held out (not used to choose): text and graphics 0.286 -> 0.333, whole band 0.232 -> 0.260,
 the banner's photo regions -0.013 to +0.0003, and the plots as high-quality JPEGs, whose
 flat areas survive, gained 0.002-0.165; no case lost.
+
+Where the filter keeps flat colours (``aarecovery.plan.flat_colours``), thin features in the
+drawn regions also get their pure colours, gated by the local plan's regions' weight
+(``aarecovery.spec.pure_colours.PureColourPrior.drawn_only``); ``analysis`` has the figures.
 """
 
 from ..spec.local_plan import LocalStrength

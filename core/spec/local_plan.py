@@ -49,7 +49,10 @@ flatness (a camera's clipped shadows: the tuning half's grey photo under G'MIC's
 that take the local plan: text and graphics 0.360 -> 0.409 of their edge error removed, the
 whole edge band 0.339 -> 0.372, the photo regions 0.294 -> 0.287; full strength on exactly
 the overlay's pixels (an oracle) reaches 0.434 and 0.399. The rest of the 0.9 target is not
-a question of strength: thin features' pure colours on the same oracle reach 0.606.
+a question of strength: thin features' pure colours on the same oracle reach 0.606. So the
+pure colours act over a photo too, where this plan reads drawn content: the extension goes
+the share of the way that the regions' weight (:meth:`LocalStrength.region_weight`) says,
+none in the photo (measured in ``aarecovery.plan.analysis``).
 """
 
 from dataclasses import dataclass
@@ -309,10 +312,24 @@ class LocalStrength:
         encoded : ndarray of float32, shape (H, W, 3)
             O's sRGB-encoded colour.
         """
-        weight = hard_edged_weight(flat_share(encoded))
+        weight = self.region_weight(encoded)
         if self.drawn_ink:
             weight = np.maximum(weight, ink_weight(encoded))
         return self._from_weight(weight)
+
+    @staticmethod
+    def region_weight(encoded):
+        """float32 ``(H, W)``: the regions' weight alone, 0 (textured) to 1 (hard-edged), smooth
+        between (:func:`hard_edged_weight` of :func:`flat_share`), without the drawn ink: where
+        the pure colours of a prior that acts on drawn content only act
+        (``aarecovery.spec.pure_colours.PureColourPrior.drawn_only``).
+
+        Parameters
+        ----------
+        encoded : ndarray of float32, shape (H, W, 3)
+            O's sRGB-encoded colour.
+        """
+        return hard_edged_weight(flat_share(encoded))
 
     def factor_at(self, encoded, rows, cols):
         """float32 ``(K,)``: :meth:`factor` at the pixels ``(rows[k], cols[k])`` of O only,

@@ -23,7 +23,7 @@ __all__ = ["to_working_space", "fit_blend_model", "jacobi_step", "from_working_s
 
 
 def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=None, blend_space="linear",
-                    factor=None, untouched_span=0.0):
+                    factor=None, untouched_span=0.0, gate=None):
     """Fit the two-colour blend model at every pixel of O (section 3.1) and its confidence.
 
     The GL pass of this name also writes the first Jacobi iterate, which it can form from
@@ -51,6 +51,9 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
         Above 0, ``beta`` is multiplied last by
         :func:`~aarecovery.spec.blend_model.untouched_factor` (a smoothing filter's untouched
         edges, ``aarecovery.plan.smoothing``); 0 leaves it as it is.
+    gate : ndarray of float32, shape (H, W), optional
+        Where a `prior` that acts on drawn content only acts, from 0 to 1: the local plan's
+        weight of the drawn regions (``LocalStrength.region_weight``).
 
     Returns
     -------
@@ -59,7 +62,7 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
     if prior is None:
         model = fit_paper_model(original, filtered, sigma_d, sigma_e, strength)
     else:
-        model = fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space)
+        model = fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, gate)
     if factor is not None:
         model.beta = (model.beta * factor).astype(np.float32)
     if untouched_span > 0:
@@ -69,7 +72,7 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
 
 
 def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1.0, prior=None,
-                    blend_space="linear", factor=None, untouched_span=0.0, model=None):
+                    blend_space="linear", factor=None, untouched_span=0.0, gate=None, model=None):
     """Fit the model and run the Jacobi iterations on working-space images.
 
     Parameters are those of :func:`fit_blend_model`, `iterations` (0 returns F) and `model`,
@@ -83,7 +86,7 @@ def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1
     """
     if model is None:
         model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, factor,
-                                untouched_span)
+                                untouched_span, gate)
     recovered = filtered
     for _ in range(iterations):
         recovered = jacobi_step(recovered, filtered, model)

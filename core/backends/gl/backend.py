@@ -62,7 +62,7 @@ _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("mode
                  "edge_strength": ("edge", 0), "strength": ("strength", 0)}
 # The textures made when first needed: (components, dtype); "result" has F's.
 _WORK_TEXTURES = {"original_work": (4, "f4"), "filtered_work": (4, "f4"), "model": (4, "f4"), "edge": (1, "f4"),
-                  "local_flat": (1, "f4"), "local_rows": (1, "f4"), "strength_factor": (1, "f4"), "strength": (1, "f4"),
+                  "local_flat": (1, "f4"), "local_rows": (1, "f4"), "strength_factor": (2, "f4"), "strength": (1, "f4"),
                   "jacobi_constant": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4")}
 _RESULT_BITS = {np.dtype(np.uint8): 8, np.dtype(np.uint16): 16}
 
@@ -352,6 +352,8 @@ class GLBackend:
         defines = {**self._defines, "PURE_COLOURS": int(prior is not None), "LOCAL_STRENGTH": int(local)}
         if prior is not None:
             defines.update(self._pure_colour_defines(prior))
+            # Pure colours on drawn content only, gated by the local plan's regions' weight.
+            defines["PURE_GATE"] = int(local and prior.drawn_only)
         with self._passes():
             if local:
                 self._local_factor(plan.local, None if maps else (lists, active))
@@ -408,8 +410,9 @@ class GLBackend:
         """The strength map of the maps: the plan's strength times the local factor (read back)."""
         factor = None
         if plan.local is not None:
-            factor = np.empty(self._key[0][::-1], np.float32)
-            self._work("strength_factor").read_into(factor)
+            both = np.empty(self._key[0][::-1] + (2,), np.float32)
+            self._work("strength_factor").read_into(both)
+            factor = both[..., 0]
         self._work("strength").write(strength_map(plan, factor, self._key[0][::-1]))
 
     def _transfer_table(self, prior):

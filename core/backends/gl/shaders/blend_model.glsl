@@ -11,7 +11,8 @@ uniform float strength;  // the safe default's per-image repair strength; 1 for 
 // smoothstep of F's largest channel change up to this, last. Twin: untouched_factor.
 uniform float untouched_span;
 #if LOCAL_STRENGTH
-// The local plan's per-pixel factor of beta (aarecovery.spec.local_plan), after the strength.
+// The local plan's per-pixel factor of beta (aarecovery.spec.local_plan), after the strength,
+// in .r; its regions' weight, which gates pure colours on drawn content only, in .g.
 uniform sampler2D strength_factor;
 #endif
 
@@ -137,8 +138,13 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
     // The extremes' offsets as base-3 digits (x and y of a, then of b); jacobi.glsl decodes them.
     float code = float((offset_a.x + 1) + 3 * (offset_a.y + 1) + 9 * (offset_b.x + 1) + 27 * (offset_b.y + 1));
 #if PURE_COLOURS
-    Extension ext_a = extend_extreme(c_a, c_b, p + offset_a, f_a, size);
-    Extension ext_b = extend_extreme(c_b, c_a, p + offset_b, f_b, size);
+#if PURE_GATE
+    float gate = texelFetch(strength_factor, p, 0).g;  // the regions' weight (local_plan.glsl)
+#else
+    float gate = 1.0;
+#endif
+    Extension ext_a = extend_extreme(c_a, c_b, p + offset_a, f_a, size, gate);
+    Extension ext_b = extend_extreme(c_b, c_a, p + offset_b, f_b, size, gate);
     if (ext_a.extended || ext_b.extended) {
         vec4 pure_span = ext_a.colour - ext_b.colour;
         float pure_span_sq = dot(pure_span, pure_span);
@@ -147,7 +153,11 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
     if (ext_a.extended) { f_a = ext_a.filtered; code += 81.0; }
     if (ext_b.extended) { f_b = ext_b.filtered; code += 162.0; }
     vec4 contrast_vector = f_a - f_b;
-    edge = original_gradient * max(filtered_gradient, sqrt(dot(contrast_vector, contrast_vector)));
+    float contrast = sqrt(dot(contrast_vector, contrast_vector));
+#if PURE_GATE
+    contrast *= gate;  // the photo keeps the paper's edge strength (fit_pure_colour_model)
+#endif
+    edge = original_gradient * max(filtered_gradient, contrast);
 #endif
     fit.edge = edge;
     float beta = confidence(residual, edge);

@@ -79,7 +79,9 @@ float ink_weight(ivec2 p, ivec2 size) {
     return weight;
 }
 
-float local_plan(ivec2 p, ivec2 size) {
+// Passes 1 and 2: their value in .x; pass 3: the factor and the regions' weight alone (the
+// gate of pure colours on drawn content only, LocalStrength.region_weight).
+vec2 local_plan(ivec2 p, ivec2 size) {
 #if LOCAL_PASS == 1
     // Flat: the 3 x 3 neighbourhood (borders replicated) spans at most FLAT_SPAN in every
     // channel, and is not black.
@@ -95,7 +97,7 @@ float local_plan(ivec2 p, ivec2 size) {
     vec3 span = brightest - lowest;
     bool flat_ = max(span.r, max(span.g, span.b)) <= FLAT_SPAN
                  && max(brightest.r, max(brightest.g, brightest.b)) > FLAT_SPAN;
-    return flat_ ? 1.0 : 0.0;
+    return vec2(flat_ ? 1.0 : 0.0, 0.0);
 #elif LOCAL_PASS == 2
     // Counts are whole numbers below 2^24: float sums are exact, in any order.
     float count = 0.0;
@@ -103,7 +105,7 @@ float local_plan(ivec2 p, ivec2 size) {
         int x = p.x + d;
         if (x >= 0 && x < size.x) count += texelFetch(local_input, ivec2(x, p.y), 0).r;
     }
-    return count;
+    return vec2(count, 0.0);
 #else
     float count = 0.0;
     for (int d = -REGION_RADIUS; d <= REGION_RADIUS; ++d) {
@@ -114,8 +116,9 @@ float local_plan(ivec2 p, ivec2 size) {
     ivec2 high = min(p + REGION_RADIUS, size - 1);
     float inside = float((high.x - low.x + 1) * (high.y - low.y + 1));
     float t = clamp((count / inside - TEXTURED_SHARE) / (HARD_EDGED_SHARE - TEXTURED_SHARE), 0.0, 1.0);
-    float weight = t * t * (3.0 - 2.0 * t);
+    float region = t * t * (3.0 - 2.0 * t);
+    float weight = region;
     if (drawn_ink != 0 && weight < 1.0) weight = max(weight, ink_weight(p, size));  // the ink is at most 1
-    return textured + (1.0 - textured) * weight;
+    return vec2(textured + (1.0 - textured) * weight, region);
 #endif
 }

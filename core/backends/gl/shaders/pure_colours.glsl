@@ -8,6 +8,11 @@ uniform int palette_size;
 uniform vec3 key_low;              // O's key range (bin centres of the table's first and last
 uniform vec3 key_high;             // filled bins, per column); beyond it the table is extrapolated
 uniform float noise_contrast;      // O's compression noise as a contrast (0: not compressed)
+// PURE_GATE: 1: the prior acts on drawn content only, `gate` (the local plan's region
+//            weight, 0 to 1) of the way (PureColourPrior.drawn_only)
+#ifndef PURE_GATE
+#define PURE_GATE 0
+#endif
 
 // The prior's switches are compile-time defines, not uniforms: llvmpipe runs both sides of
 // every branch under a mask, so a uniform switch paid for every key's sRGB conversions
@@ -145,8 +150,8 @@ struct Extension {
 };
 
 // Is the extreme `far` at pixel q a thin feature's partial colour? If so, extend it along the
-// line from `near` to the colour cube.
-Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 size) {
+// line from `near` to the colour cube (with PURE_GATE, `gate`'s share of the way).
+Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 size, float gate) {
     Extension result = Extension(false, far, far);
     vec4 span = far - near;
     float len = sqrt(dot(span, span));
@@ -227,6 +232,10 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
     else return result;
 #endif
     if (!(reach > MIN_REACH)) return result;  // the extreme is the ink itself
+#if PURE_GATE
+    if (!(gate > 0.0)) return result;
+    reach = 1.0 + gate * (reach - 1.0);
+#endif
     result.extended = true;
     result.colour = near + reach * span;
     // At an end of O's key range the extreme is read with the table clamped there (a dark

@@ -1,0 +1,100 @@
+"""Pure colours of thin features over a photo: gated by the local plan's weight, so that they
+act on the text and drawings and not on the photo, and fade in with the weight."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import aarecovery
+from aarecovery import Decision
+from aarecovery.spec import recover_working, to_working_space
+from aarecovery.spec.local_plan import LocalStrength, flat_share, hard_edged_weight, ink_weight
+from test_local_plan import banner_over_photo  # noqa: F401 (a fixture)
+
+
+def _plan_and_work(case):
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        plan = engine.plan()
+        forced = engine.plan(strength=0.5)
+    rgba = lambda image: np.concatenate([image, np.ones(image.shape[:2] + (1,), np.float32)], -1)
+    space = dict(linear_input=False, blend_space=plan.blend_space)
+    return plan, forced, to_working_space(rgba(case.original), **space), to_working_space(rgba(case.filtered), **space)
+
+
+def test_over_a_photo_the_pure_colours_are_gated_by_the_local_plan(banner_over_photo):
+    plan, forced, _, _ = _plan_and_work(banner_over_photo)
+    assert plan.decision == Decision.POINTWISE_CALIBRATED and plan.local is not None
+    assert plan.pure_colours is not None and plan.pure_colours.drawn_only
+    # A strength the user gives drops the local plan, and the gated pure colours with it.
+    assert forced.local is None and forced.pure_colours is None
+
+
+def test_the_gate_is_the_regions_weight_without_the_drawn_ink(banner_over_photo):
+    encoded = banner_over_photo.original
+    gate = LocalStrength.region_weight(encoded)
+    np.testing.assert_array_equal(gate, hard_edged_weight(flat_share(encoded)))
+    # The factor also counts drawn ink, which the gate leaves out (a grey photo's levels
+    # recur as exactly as ink: see plan/analysis.py).
+    local = LocalStrength(0.25)
+    weight = np.maximum(gate, ink_weight(encoded))
+    np.testing.assert_allclose(local.factor(encoded), 0.25 + 0.75 * weight, atol=1e-6)
+    assert (weight > gate).any() and gate.min() == 0 and gate.max() == 1
+
+
+def test_the_gate_fades_the_extension_in_and_leaves_the_photo_the_papers(banner_over_photo):
+    plan, _, work_o, work_f = _plan_and_work(banner_over_photo)
+    prior, textured = plan.pure_colours, plan.local.textured
+    shape = work_o.shape[:2]
+
+    def run(gate, gated=True):
+        factor = np.full(shape, textured + (1 - textured) * gate, np.float32)
+        return recover_working(work_o, work_f, plan.sigma_d, plan.sigma_e, plan.iterations, plan.strength, prior,
+                               plan.blend_space, factor, gate=np.full(shape, gate, np.float32) if gated else None)
+
+    # Gate 0 (a photo): no extension, and the paper's model and result at that strength.
+    photo, model = run(0.0)
+    assert not model.pure_a.any() and not model.pure_b.any()
+    factor = np.full(shape, textured, np.float32)
+    paper, paper_model = recover_working(work_o, work_f, plan.sigma_d, plan.sigma_e, plan.iterations, plan.strength,
+                                         None, plan.blend_space, factor)
+    np.testing.assert_allclose(model.beta, paper_model.beta, atol=1e-6)
+    np.testing.assert_allclose(photo, paper, atol=1e-6)
+    # Gate 1 (a drawing): the prior as on hard-edged content.
+    full, full_model = run(1.0)
+    ungated, ungated_model = run(1.0, gated=False)
+    assert full_model.pure_a.sum() + full_model.pure_b.sum() > 20
+    np.testing.assert_array_equal(full_model.pure_a, ungated_model.pure_a)
+    np.testing.assert_allclose(full, ungated, atol=1e-5)
+    # Between: the same extremes extended, the pure colours that share of the way.
+    _, faint = run(1e-6)
+    _, half = run(0.5)
+    np.testing.assert_array_equal(half.pure_a, full_model.pure_a)
+    np.testing.assert_array_equal(faint.pure_b, full_model.pure_b)
+    np.testing.assert_allclose(half.colour_a, (faint.colour_a + full_model.colour_a) / 2, atol=1e-5)
+    # With the local plan's own regions' weight: the photo below the banner is not extended.
+    encoded = banner_over_photo.original
+    gate = plan.local.region_weight(encoded)
+    _, local_model = recover_working(work_o, work_f, plan.sigma_d, plan.sigma_e, plan.iterations, plan.strength,
+                                     prior, plan.blend_space, plan.local.factor(encoded), gate=gate)
+    extended = local_model.pure_a | local_model.pure_b
+    assert extended.any() and (gate[extended] > 0).all() and (gate == 0).any()
+
+
+@pytest.mark.filterwarnings("ignore::aarecovery.errors.TileSizeWarning")
+def test_gated_pure_colours_agree_on_both_backends_and_tiled(banner_over_photo, gl_path):
+    case = banner_over_photo
+    numpy_result = aarecovery.recover(case.original, case.filtered, backend="numpy")
+    with aarecovery.Engine("gl", gl_path=gl_path) as engine:
+        gl_result = aarecovery.recover(case.original, case.filtered, engine=engine)
+        assert engine.last_plan.pure_colours.drawn_only
+    np.testing.assert_allclose(gl_result, numpy_result, atol=1e-5)
+    for tile in (24, 40):
+        tiled = aarecovery.recover(case.original, case.filtered, backend="gl", gl_path=gl_path, tile_size=tile)
+        np.testing.assert_array_equal(tiled, gl_result)
+    # The gate changed the result: without pure colours it differs on the banner's bars.
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        engine.run(dataclasses.replace(engine.plan(), pure_colours=None))
+        assert np.abs(engine.result() - numpy_result).max() > 0.05
