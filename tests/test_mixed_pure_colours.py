@@ -8,9 +8,17 @@ import pytest
 
 import aarecovery
 from aarecovery import Decision
+from aarecovery.lab import scenes as _scenes
+from aarecovery.lab.groundtruth import make_case
+from aarecovery.plan.mixed_content import DRAWN_REGION_SHARE, drawn_only
+from aarecovery.spec.sobel import gradient_magnitude
 from aarecovery.spec import recover_working, to_working_space
 from aarecovery.spec.local_plan import LocalStrength, flat_share, hard_edged_weight, ink_weight
 from test_local_plan import banner_over_photo  # noqa: F401 (a fixture)
+from test_local_plan import _BANNER
+
+# The banner covers O's top rows; the photo lies below them (a margin for the local plan's square).
+_BANNER_ROWS = _BANNER + 20
 
 
 def _plan_and_work(case):
@@ -29,6 +37,27 @@ def test_over_a_photo_the_pure_colours_are_gated_by_the_local_plan(banner_over_p
     assert plan.pure_colours is not None and plan.pure_colours.drawn_only
     # A strength the user gives drops the local plan, and the gated pure colours with it.
     assert forced.local is None and forced.pure_colours is None
+
+
+def test_a_photo_with_no_drawn_region_gets_no_gated_pure_colours(banner_over_photo):
+    # The same photo without the banner: calibrated and local, but a prior gated shut
+    # everywhere would only cost its passes over every active block.
+    photo = make_case(_scenes.render("astronaut", 128, 4), "posterize", 4, "linear")
+    plan, _, _, _ = _plan_and_work(photo)
+    assert plan.decision == Decision.POINTWISE_CALIBRATED and plan.local is not None
+    assert plan.pure_colours is None
+    # The rule itself, on the banner's window: its drawn regions pass, the photo's part not.
+    banner_plan, _, _, _ = _plan_and_work(banner_over_photo)
+    prior = dataclasses.replace(banner_plan.pure_colours, drawn_only=False)
+    encoded = banner_over_photo.original
+    edges = gradient_magnitude(encoded) > 0.02
+    gated = drawn_only(prior, encoded, edges)
+    assert gated is not None and gated.drawn_only
+    below = encoded[_BANNER_ROWS:]
+    below_edges = gradient_magnitude(below) > 0.02
+    assert np.mean(LocalStrength.region_weight(below)[below_edges] > 0) < DRAWN_REGION_SHARE
+    assert drawn_only(prior, below, below_edges) is None
+    assert drawn_only(None, encoded, edges) is None
 
 
 def test_the_gate_is_the_regions_weight_without_the_drawn_ink(banner_over_photo):

@@ -60,7 +60,6 @@ All of it runs once, in NumPy, on a central crop, before tiling, and results in 
 :class:`PairAnalysis` that ``aarecovery.plan.make_plan`` turns into the backends' Plan.
 """
 
-import dataclasses
 from dataclasses import dataclass
 
 from ..backends.base import Decision
@@ -78,7 +77,7 @@ from .forcing import forcing_advice
 from .hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screentone_drawing
 from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
-from .mixed_content import MIXED_DRAWN_SHARE, drawn_share
+from .mixed_content import MIXED_DRAWN_SHARE, drawn_only, drawn_share
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
 from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, paper_grain
 from .pointwise import POINTWISE_SHARE, fit_pointwise
@@ -282,10 +281,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # 1.78 dB against F. Held out (not used to choose): the mixed lines did not move, as
         # the banner's and the map's overlays have almost no flat region (gate open on 3 %
         # and 0 % of their pixels).
-        prior = pure_colour_prior(o, transfer, space, f, edges, noise_contrast=compression.contrast,
-                                  extend_ends=not compression.compressed)
-        if prior is not None:
-            prior = dataclasses.replace(prior, drawn_only=True)
+        prior = drawn_only(pure_colour_prior(o, transfer, space, f, edges, noise_contrast=compression.contrast,
+                                             extend_ends=not compression.compressed), o, edges)
         thin = ", pure colours of thin features there" if prior is not None else ""
         return PairAnalysis(space, 1.0, why + " for textured regions, full strength for hard-edged ones" + thin,
                             Decision.POINTWISE_CALIBRATED, prior, local=LocalStrength(strength))
@@ -313,8 +310,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                     # +0.03 to +0.22), photo regions unchanged; the poster's filters keep no
                     # flat colours there. Every filter's text and graphics 0.387 -> 0.402.
                     prior, kept = flat_colour_prior(o, f, edges)
-                    if prior is not None:
-                        prior = dataclasses.replace(prior, drawn_only=True)
+                    prior = drawn_only(prior, o, edges)
                     pure = f", pure colours of thin features there ({kept})" if prior is not None else ""
                     return PairAnalysis(space, strength,
                                         f"neighbourhood filter on a textured image ({texture}) with text or drawings "
