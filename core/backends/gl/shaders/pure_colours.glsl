@@ -153,6 +153,10 @@ struct Extension {
 // line from `near` to the colour cube (with PURE_GATE, `gate`'s share of the way).
 Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 size, float gate) {
     Extension result = Extension(false, far, far);
+#if PURE_GATE
+    // Shut (a photo region): never extended, as at the end of the tests below, without them.
+    if (!(gate > 0.0)) return result;
+#endif
     vec4 span = far - near;
     float len = sqrt(dot(span, span));
     if (!(len > 1e-6)) return result;
@@ -233,7 +237,6 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
 #endif
     if (!(reach > MIN_REACH)) return result;  // the extreme is the ink itself
 #if PURE_GATE
-    if (!(gate > 0.0)) return result;
     reach = 1.0 + gate * (reach - 1.0);
 #endif
     result.extended = true;
