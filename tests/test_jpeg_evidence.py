@@ -168,3 +168,53 @@ def test_a_jpeg_drawing_is_hard_edged_and_a_jpeg_photo_textured(quality):
     evidence = compression_evidence(photo)
     assert evidence.compressed
     assert is_textured(photo, 0.0, evidence)[0]
+
+
+def _page(family, space, quality):
+    from aarecovery.lab.realtools import render_family
+    from aarecovery.plan.resample import box_downsample
+    page = np.rint(box_downsample(render_family(family, 96), 8, space) * 255).astype(np.uint8)
+    return _encoded(_jpeg_round_trip(page, quality))
+
+
+def _rgba(encoded):
+    return np.concatenate([encoded, np.ones_like(encoded[..., :1])], axis=-1)
+
+
+def test_a_jpeg_drawing_without_a_visible_grid_has_flat_blocks_and_a_photo_not():
+    # At q 98 the serif page's grid is not found in its pixels and its ringing reads as
+    # grain; its edge-free blocks are flat at some phase, a JPEG photo's are not.
+    from importlib import resources
+
+    from aarecovery.plan.compression import hidden_compression
+    from aarecovery.plan.texture import is_textured
+    page = _page("serif", "linear", 98)
+    assert not compression_evidence(page).compressed
+    assert is_textured(page, 0.0, NO_COMPRESSION)[0]
+    hidden = hidden_compression(page)
+    assert hidden.source == "flat blocks" and hidden.noise > 0
+    assert not is_textured(page, 0.0, hidden)[0]
+    with resources.files("aarecovery").joinpath("data/photo_camera.png").open("rb") as handle:
+        photo = np.asarray(Image.open(handle).convert("RGB"))[:256, :256]
+    photo = _encoded(_jpeg_round_trip(np.ascontiguousarray(photo[::2, ::2]), 98))
+    assert hidden_compression(photo) == NO_COMPRESSION
+
+
+def test_an_unsharp_mask_on_a_jpeg_drawing_is_repaired():
+    # Read by its flat blocks, the q 98 page is hard-edged content under an unsharp mask (F
+    # was kept as a textured image's); the star burst at q 85 (grid found) is repaired at a
+    # repair-to-error ratio below the bar a smoothing filter needs on compressed content.
+    from aarecovery.filters.spatial import unsharp_mask
+    from aarecovery.plan.analysis import analyse
+    from aarecovery.plan.compression import COMPRESSED_REPAIR_TO_ERROR
+    from aarecovery.plan.model_error import repair_to_error_ratio
+    for family, quality in (("serif", 98), ("starburst", 85)):
+        page = _page(family, "linear", quality)
+        filtered = np.clip(unsharp_mask(page, radius=1.5, amount=1.5), 0, 1).astype(np.float32)
+        analysis = analyse(_rgba(page), _rgba(filtered))
+        assert analysis.decision == aarecovery.Decision.NEIGHBOURHOOD_HARD_EDGED, analysis.reason
+        assert analysis.strength == 1.0
+    assert compression_evidence(page).source == "block grid"
+    ratio = repair_to_error_ratio(_rgba(page), _rgba(filtered), linear_input=False, blend_space=analysis.blend_space,
+                                  sigma_d=aarecovery.params.SIGMA_D.default, sigma_e=aarecovery.params.SIGMA_E.default)
+    assert ratio < COMPRESSED_REPAIR_TO_ERROR

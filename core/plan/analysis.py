@@ -28,7 +28,8 @@ colour lines better), then takes the first of these exits that applies, each nam
    backends apply per tile; there, and not in the photo, the pure colours of thin features
    act too (``pure_colours``, gated by the local plan's weight).
 6. ``NEIGHBOURHOOD_TEXTURED_KEPT``: any other filter on a textured image (but a comic's
-   screentone, whose dots read as grain: ``hatching``) that is not a
+   screentone, whose dots read as grain: ``hatching``, and a JPEG drawing whose grid the
+   pixels did not show, whose ringing does: ``compression.hidden_compression``) that is not a
    colour map of all three channels at once (``colour_map``): it cannot be simulated and
    the model would flatten the texture, F is kept. ``NEIGHBOURHOOD_MIXED``
    (``mixed_content``): the same where text or drawings cover part of the photo: they are
@@ -40,8 +41,8 @@ colour lines better), then takes the first of these exits that applies, each nam
 8. ``COLOUR_MAP_CALIBRATED``: a colour map (a palette quantiser) on a textured image: the
    calibrated strength, as for a table.
 9. ``NEIGHBOURHOOD_HARD_EDGED_KEPT``: a neighbourhood filter on hard-edged content whose
-   repairs are no larger than the model's own error (a stricter bar for a compressed O):
-   F is kept.
+   repairs are no larger than the model's own error (a stricter bar for a smoothing filter on
+   a compressed O): F is kept.
 10. ``NEIGHBOURHOOD_HARD_EDGED``: a neighbourhood filter on hard-edged content: the paper's
     passes at full strength (lower for a smoothing filter, and none where it left O's pixel
     as it was: ``smoothing``) and, where the
@@ -71,7 +72,8 @@ from ..spec.sobel import gradient_magnitude
 from .blend_space import choose_blend_space
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
-from .compression import COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SMOOTHED_STRENGTH, compression_evidence
+from .compression import (COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SMOOTHED_STRENGTH, compression_evidence,
+                          hidden_compression)
 from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
 from .hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screentone_drawing
@@ -286,6 +288,19 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         thin = ", pure colours of thin features there" if prior is not None else ""
         return PairAnalysis(space, 1.0, why + " for textured regions, full strength for hard-edged ones" + thin,
                             Decision.POINTWISE_CALIBRATED, prior, local=LocalStrength(strength))
+    # A JPEG whose grid the pixels did not show (q 90-98) reads as grain around its edges;
+    # where its edge-free blocks are flat at some phase it is a drawing from a JPEG
+    # (plan/compression.py): under a neighbourhood filter it goes on to the hard-edged branch
+    # with that evidence. Tuning half, the five neighbourhood filters: serif (q 95-98) under
+    # the unsharp masks and G'MIC's bilateral 0 -> 0.20-0.66 of its edge error, the star burst
+    # (q 98) under GEGL's unsharp mask 0 -> 0.60; no other case moved. Not for point-wise
+    # filters: there the star burst (q 98) under GEGL's exposure went from 0.17 to -0.30
+    # (1.14 dB worse than F) at the compressed branch's calibrated strength.
+    if textured and not compression.compressed:
+        hidden = hidden_compression(o)
+        if hidden.compressed:
+            compression = hidden
+            textured, texture = is_textured(o, fit, compression)
     colour_map = fit_colour_map(o, f, edges) if textured else None
     # A comic's screentone reads as texture, but it is a drawing (plan/hatching.py): under a
     # neighbourhood filter that is no colour map it goes on to the hard-edged branch below.
@@ -340,18 +355,20 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                             forcing=forcing_advice(Decision.COLOUR_MAP_CALIBRATED, errors=errors) if strength == 0
                             else None)
     ratio = _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e)
-    needed = COMPRESSED_REPAIR_TO_ERROR if compression.compressed else MIN_REPAIR_TO_ERROR
+    # A smoothing filter averages part of an edge's damage away, as the reference does
+    # (plan/smoothing.py); on compressed content it needs a larger ratio than a sharpening
+    # one (see COMPRESSED_REPAIR_TO_ERROR).
+    smoothing = contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST
+    needed = COMPRESSED_REPAIR_TO_ERROR if compression.compressed and smoothing else MIN_REPAIR_TO_ERROR
     if ratio < needed:
         return PairAnalysis(space, 0.0, f"neighbourhood filter on hard-edged content, but the repairs would be "
                                         f"no larger than the model's own error (ratio {ratio:.2f} < "
                                         f"{needed:g}" + (f" above {compression.describe()}" if compression.compressed
                                                          else "") + "): kept F", Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT,
                             forcing=forcing_advice(Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT, ratio))
-    # A smoothing filter averages part of an edge's damage away, as the reference does
-    # (plan/smoothing.py).
-    smoothing = contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST
-    # It also leaves some edges as O had them (a bilateral filter's strong edges), and so does
-    # the reference: there the confidence falls to 0 (UNTOUCHED_SPAN, in the model's pass).
+    # A smoothing filter also leaves some edges as O had them (a bilateral filter's strong
+    # edges), and so does the reference: there the confidence falls to 0 (UNTOUCHED_SPAN, in
+    # the model's pass).
     untouched = dict(untouched_span=UNTOUCHED_SPAN if smoothing else 0.0)
     # On a page with a coarse paper grain (plan/paper_grain.py) it spreads the grain as it
     # spreads a JPEG's noise, so the repair runs at the grain's sigma_e, at a lower strength

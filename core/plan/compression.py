@@ -30,7 +30,7 @@ import numpy as np
 
 from ..colour import REC601_LUMA
 
-__all__ = ["quiet_block_grain", "BLOCK_GRAIN_SHARE", "CompressionEvidence", "NO_COMPRESSION", "BLOCK", "noise_from_tables", "detect_block_grid",
+__all__ = ["quiet_block_grain", "hidden_compression", "BLOCK_GRAIN_SHARE", "CompressionEvidence", "NO_COMPRESSION", "BLOCK", "noise_from_tables", "detect_block_grid",
            "compression_evidence", "GRID_MARGIN", "STANDARD_LUMA_TABLE",
            "NOISE_CONTRAST_SIGMAS", "MIN_NOISE_CONTRAST",
            "COMPRESSED_REPAIR_TO_ERROR", "COMPRESSED_SMOOTHED_STRENGTH"]
@@ -51,12 +51,15 @@ _BLOCK_GRAIN_RANGE = 2.5
 _BLOCK_EDGE_RANGE = 24.0
 # Fewer edge-free blocks than this leave the grain undecided (dense line art).
 _MIN_QUIET_BLOCKS = 16
-#: The repair-to-error ratio (``aarecovery.plan.model_error``) a neighbourhood filter on
-#: compressed hard-edged content needs before it is repaired at all: the model's error
-#: carried through the filter underestimates what ringing does there. Tuning half, JPEG
-#: drawings: G'MIC's bilateral on the star burst (q 85) ratio 5.9 lost 0.14 dB; unsharp masks
-#: 6.9 (star burst, +0.28 in error reduction) and 20 (serif, +0.20). Set above the loss with
-#: a margin, not swept: held out, every repaired case had a ratio over 100.
+#: The repair-to-error ratio (``aarecovery.plan.model_error``) a smoothing filter
+#: (``aarecovery.plan.smoothing``) on compressed hard-edged content needs before it is
+#: repaired at all: the model's error carried through the filter underestimates what the
+#: filter does to the ringing there. Tuning half, JPEG drawings: G'MIC's bilateral on the
+#: star burst (q 85) ratio 5.9 lost 0.14 dB. Set above the loss with a margin, not swept:
+#: held out, every repaired case had a ratio over 100. A sharpening filter (an unsharp mask)
+#: needs only :data:`~aarecovery.plan.model_error.MIN_REPAIR_TO_ERROR`: on the tuning half's
+#: JPEG drawings it gained at every ratio from 5 up (the star burst 5.0 and 6.9: 0.60 and 0.28
+#: of its edge error; serif 13-20: 0.20-0.66), and the bar kept F on the star burst.
 COMPRESSED_REPAIR_TO_ERROR = 10.0
 #: The strength under a smoothing filter (``aarecovery.plan.smoothing``) on hard-edged
 #: content from a JPEG, without pure colours: the filter spreads the compression noise over
@@ -118,8 +121,10 @@ class CompressionEvidence:
 
     Attributes
     ----------
-    source : {"none", "quantization tables", "block grid"}
-        Where the evidence came from; "none": O shows no compression.
+    source : {"none", "quantization tables", "block grid", "flat blocks"}
+        Where the evidence came from; "none": O shows no compression; "flat blocks": no grid
+        was found, but the pixels' grain lies only in blocks that hold an edge
+        (:func:`hidden_compression`).
     noise : float
         Standard deviation of the compression error per pixel, encoded values in [0, 1];
         0 without compression.
@@ -243,7 +248,7 @@ def detect_block_grid(encoded):
         The standard luma table scaled to the steps measured at low frequencies on the grid
         (None when undecided).
     """
-    luma = encoded[..., :3].astype(np.float64) @ np.array(REC601_LUMA) * 255.0
+    luma = _luma(encoded)
     if min(luma.shape) < 2 * BLOCK:
         return (0, 0), 0.0, None
     shares = np.full((BLOCK, BLOCK), -1.0)
@@ -302,8 +307,15 @@ def quiet_block_grain(encoded, evidence):
     float or None
         None when fewer than 16 blocks are free of edges.
     """
-    luma = encoded[..., :3].astype(np.float64) @ np.array(REC601_LUMA) * 255.0
-    row, column = evidence.phase
+    return _block_grain_at(_luma(encoded), *evidence.phase)
+
+
+def _luma(encoded):
+    return encoded[..., :3].astype(np.float64) @ np.array(REC601_LUMA) * 255.0
+
+
+def _block_grain_at(luma, row, column):
+    """:func:`quiet_block_grain` of the grid at one phase, on O's luma in 8-bit levels."""
     rows, columns = (luma.shape[0] - row) // BLOCK, (luma.shape[1] - column) // BLOCK
     blocks = luma[row:row + rows * BLOCK, column:column + columns * BLOCK]
     blocks = blocks.reshape(rows, BLOCK, columns, BLOCK).transpose(0, 2, 1, 3).reshape(-1, BLOCK * BLOCK)
@@ -312,6 +324,46 @@ def quiet_block_grain(encoded, evidence):
     if quiet.size < _MIN_QUIET_BLOCKS:
         return None
     return float((quiet > _BLOCK_GRAIN_RANGE).mean())
+
+
+def hidden_compression(encoded):
+    """Evidence of a JPEG whose grid the pixels did not show: flat edge-free blocks at some phase.
+
+    At q 90-98 a JPEG's high frequencies are not all quantized to zero and its grid can go
+    undetected (:data:`GRID_MARGIN`), while the ringing around its edges still reads as grain
+    in the pixels (``aarecovery.plan.texture.grain``). The edge-free blocks of the grid's phase
+    are still flat, and those of a photo are not at any phase: the phase with the fewest
+    grainy blocks is taken, so that the grid's phase need not be known. Tuning half's
+    windows, PNG and JPEG q 75-98, the least share over the 64 phases (at least 16 edge-free
+    blocks): serif 0.00-0.05, the star burst 0.00-0.17; the camera's portrait, coffee,
+    Hubble and the screenshot 0.94-1.00 (the maps, icons, manga, handwriting, poster and
+    scans have fewer than 16 at this size).
+    The caller asks only where O read as textured without other evidence of compression: a
+    lossless drawing has flat blocks too, and reads as hard-edged before.
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (H, W, 3)
+        O's encoded colour (the analysis window).
+
+    Returns
+    -------
+    CompressionEvidence
+        Source "flat blocks" at the flattest phase, with the noise of the smallest table the
+        grid path assumes (q 95's); :data:`NO_COMPRESSION` when no phase has
+        :data:`BLOCK_GRAIN_SHARE` or fewer grainy edge-free blocks among at least 16.
+    """
+    luma = _luma(encoded)
+    best, phase = None, (0, 0)
+    for row in range(BLOCK):
+        for column in range(BLOCK):
+            share = _block_grain_at(luma, row, column)
+            if share is not None and (best is None or share < best):
+                best, phase = share, (row, column)
+    if best is None or best > BLOCK_GRAIN_SHARE:
+        return NO_COMPRESSION
+    table = np.clip(np.rint(STANDARD_LUMA_TABLE * _SMALLEST_SCALE), 1, 255)
+    return CompressionEvidence("flat blocks", noise_from_tables([table]), phase)
 
 
 def compression_evidence(encoded, tables=None):
