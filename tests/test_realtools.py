@@ -11,6 +11,7 @@ import subprocess
 import numpy as np
 import pytest
 
+import aarecovery
 from aarecovery import Decision
 from aarecovery.lab import realtools
 from aarecovery.lab.drawings import DRAWINGS
@@ -207,6 +208,50 @@ def test_small_suite_end_to_end_with_each_tool():
     assert "HELD-OUT" in format_realtools(results, half="heldout")
 
 
+def test_jpeg_cases_carry_their_files_quantization_tables(tmp_path):
+    from PIL import Image
+
+    from aarecovery import read_quantization
+    image = np.random.default_rng(3).random((24, 32, 3)).astype(np.float32)
+    decoded, tables = realtools._jpeg_round_trip(image, 85)
+    path = tmp_path / "o.jpg"
+    Image.fromarray(np.rint(image * 255).astype(np.uint8)).save(path, format="JPEG", quality=85)
+    assert tables == read_quantization(path) and len(tables[0]) == 64
+    with Image.open(path) as reread:
+        np.testing.assert_array_equal(decoded, np.asarray(reread.convert("RGB"), np.float32) / np.float32(255))
+
+
+def test_eval_gives_the_tables_to_the_recovery_only_when_asked(capsys):
+    from aarecovery.cli import main
+    require_tool("opencv")
+    argv = ["eval", "--suite", "realtools", "--scenes", "serif", "--filters", "cv-threshold", "--no-peers"]
+    lines = []
+    for extra in ([], ["--jpeg-tables"]):
+        assert main(argv + extra) == 0
+        lines.append([line for line in capsys.readouterr().out.splitlines() if "/cv-threshold/" in line])
+    # The JPEG serif's noise is read from its tables with the option (tuning half: linear q 95
+    # 0.17 -> 0.40 of its edge error), from its pixels without; the PNG cases are the same.
+    png = [[line for line in run if "/png" in line] for run in lines]
+    jpeg = [[line for line in run if "/jpeg" in line] for run in lines]
+    assert png[0] and png[0] == png[1]
+    assert jpeg[0] and jpeg[0] != jpeg[1]
+
+
+def test_a_jpeg_files_tables_do_not_hide_a_drawing_whose_grid_its_pixels_do_not_show():
+    # Serif at q 98 under GEGL's unsharp mask: its grid is not seen in the pixels, and its
+    # tables say how much noise but not where the blocks lie; the flattest phase does.
+    require_tool("gegl")
+    suite = realtools.RealToolsSuite("one", ("serif",), ("gegl-unsharp",), 96, {"serif": ("srgb",)}, (98,))
+    png, jpeg = realtools.build_cases(suite, "tune")
+    assert jpeg.quantization is not None
+    with aarecovery.Engine("numpy") as engine:
+        decisions = []
+        for tables in (None, jpeg.quantization):
+            engine.set_images(jpeg.original, jpeg.filtered, quantization=tables)
+            decisions.append(engine.plan().decision)
+    assert decisions[0] == decisions[1] == Decision.NEIGHBOURHOOD_HARD_EDGED
+
+
 def test_missing_tools_are_reported_loudly():
     from aarecovery.lab.peers import PEERS
     from aarecovery.lab.realeval import RealCaseResult
@@ -234,6 +279,7 @@ def test_eval_command_runs_the_realtools_suite(capsys):
     (["--suite", "realtools", "--half", "test"], "--half must be one of"),
     (["--suite", "realtools", "--k", "4"], "--k applies to the built-in suite only"),
     (["--half", "heldout"], "--half applies to --suite realtools only"),
+    (["--jpeg-tables"], "--jpeg-tables applies to --suite realtools only"),
     (["--suite", "realtools", "--filters", "nosuch"], "unknown filter 'nosuch'"),
 ])
 def test_eval_command_refuses_crossing_the_split(argv, message, capsys):

@@ -37,6 +37,10 @@ def register(subparsers):
     parser.add_argument("--scenes", help="comma-separated scenes, or realtools families (default: the suite's)")
     parser.add_argument("--filters", help="comma-separated filters, or realtools tool filters (default: all)")
     parser.add_argument("--no-jpeg", action="store_true", help="realtools only: skip the JPEG originals")
+    parser.add_argument("--jpeg-tables", action="store_true",
+                        help="realtools only: give the recovery each JPEG original's quantization tables, as "
+                             "'recover' reads them from a JPEG file (default: the decoded pixels only, as the "
+                             "plug-ins and arrays)")
     parser.add_argument("--backend", choices=BACKENDS, default="numpy",
                         help="recovery backend (default numpy, the specification)")
     parser.add_argument("--no-peers", action="store_true", help="skip GIMP and G'MIC")
@@ -48,7 +52,7 @@ def register(subparsers):
 def run(args):
     if args.suite == "realtools":
         return _run_realtools(args)
-    for option, given in (("--half", args.half), ("--no-jpeg", args.no_jpeg)):
+    for option, given in (("--half", args.half), ("--no-jpeg", args.no_jpeg), ("--jpeg-tables", args.jpeg_tables)):
         if given:
             raise InputError(f"{option} applies to --suite realtools only; the built-in suite has no split "
                              "and no JPEG originals")
@@ -117,13 +121,13 @@ def _run_realtools(args):
     start = time.perf_counter()
     results, missing_tools, missing_peers = run_realtools(
         suite, half, backend=args.backend, peers=not args.no_peers, jpeg=not args.no_jpeg,
-        progress=sys.stderr.isatty(), keep_images=bool(args.report))
+        progress=sys.stderr.isatty(), keep_images=bool(args.report), jpeg_tables=args.jpeg_tables)
     print(format_realtools(results, missing_tools, missing_peers, suite_name=suite.name, half=half))
     print(f"\n{len(results)} cases in {time.perf_counter() - start:.1f} s")
     if args.report:
         # The options that shape the tables, so that the block's command regenerates it.
         command = ("aarecovery eval --suite realtools" + (" --quick" if args.quick else "") + f" --half {half}"
-                   + (" --no-peers" if args.no_peers else ""))
+                   + (" --no-peers" if args.no_peers else "") + (" --jpeg-tables" if args.jpeg_tables else ""))
         path = write_realtools_report(results, args.report, missing_tools, missing_peers, suite_name=suite.name,
                                       half=half, command=command)
         print(f"report: {path}")

@@ -103,9 +103,9 @@ class RealCaseResult(CaseResult):
         return self.psnr_band["F"] < _NO_ERROR_PSNR_DB
 
 
-def _recover_both(engine, original, filtered):
+def _recover_both(engine, original, filtered, quantization=None):
     """R (safe default), paper, and the safe plan (its decision and reason), as ``recover`` makes them on one tile."""
-    engine.set_images(original, filtered)
+    engine.set_images(original, filtered, quantization=quantization)
     outputs = {}
     reason = ""
     for mode in ("safe", "paper"):
@@ -121,7 +121,7 @@ def _recover_both(engine, original, filtered):
 
 
 def run_realtools(suite, half="tune", *, backend="numpy", peers=True, jpeg=True, progress=False,
-                  keep_images=False):
+                  keep_images=False, jpeg_tables=False):
     """Run a half of the real-tools suite.
 
     Parameters
@@ -133,6 +133,10 @@ def run_realtools(suite, half="tune", *, backend="numpy", peers=True, jpeg=True,
         Also run GIMP's and G'MIC's antialias (when installed) and the joint bilateral filter.
     jpeg : bool
         Also run each case's JPEG twin.
+    jpeg_tables : bool
+        Give the recovery each JPEG original's quantization tables, as ``aarecovery recover``
+        reads them from a JPEG file; by default it sees the decoded pixels only, as the
+        plug-ins and callers with arrays do (the plan then searches them for the block grid).
     progress : bool
         Draw a progress bar on stderr.
     keep_images : bool
@@ -176,7 +180,7 @@ def run_realtools(suite, half="tune", *, backend="numpy", peers=True, jpeg=True,
             result = RealCaseResult(case.family, case.space, case.filter_name, FAMILIES[case.family].kind,
                                     float(band.mean()), tool=spec.tool, group=spec.group,
                                     half=FAMILIES[case.family].half, quality=case.quality)
-            recovered, paper, result.plan = _recover_both(engine, o, f)
+            recovered, paper, result.plan = _recover_both(engine, o, f, case.quantization if jpeg_tables else None)
             outputs = {"F": f, "R": recovered, "paper": paper}
             if peers:
                 outputs["jbf"] = joint_bilateral(f, o)

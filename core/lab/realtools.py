@@ -368,6 +368,8 @@ def _quantised(image):
 
 
 def _jpeg_round_trip(image, quality):
+    """The image saved as JPEG at `quality` and decoded, and the file's quantization tables
+    (as ``aarecovery.read_quantization`` reads them from a file)."""
     import io
 
     from PIL import Image
@@ -377,7 +379,9 @@ def _jpeg_round_trip(image, quality):
     Image.fromarray(pixels[..., 0] if grey else pixels).save(buffer, format="JPEG", quality=quality)
     buffer.seek(0)
     with Image.open(buffer) as decoded:
-        return np.asarray(decoded.convert("RGB"), np.float32) / np.float32(255)
+        tables = decoded.quantization
+        decoded_pixels = np.asarray(decoded.convert("RGB"), np.float32) / np.float32(255)
+    return decoded_pixels, [list(tables[key]) for key in sorted(tables)]
 
 
 @dataclass
@@ -389,6 +393,8 @@ class RealCase:
     family, space, filter_name : str
     quality : int or None
         JPEG quality of O, None for PNG.
+    quantization : list of list of int or None
+        The quantization tables of O's JPEG file, None for PNG.
     original, filtered, reference : ndarray of float32, shape (H, W, 3)
     regions : dict of str to ndarray of bool, shape (H, W), or None
         Mixed content: ``"text/graphics"`` and ``"photo"``, a partition of the image.
@@ -405,6 +411,7 @@ class RealCase:
     reference: np.ndarray = None
     regions: dict = None
     paper: np.ndarray = None
+    quantization: list = None
 
 
 def build_cases(suite, half="tune", *, jpeg=True, tools=None, progress=None):
@@ -447,7 +454,8 @@ def build_cases(suite, half="tune", *, jpeg=True, tools=None, progress=None):
             quality = suite.jpeg_quality(name, space, filter_name)
             if (name, space, quality) not in originals:
                 originals[name, space, quality] = _jpeg_round_trip(originals[name, space, None], quality)
-            cases.append(RealCase(name, space, filter_name, quality, originals[name, space, quality], **marks))
+            jpeg_original, tables = originals[name, space, quality]
+            cases.append(RealCase(name, space, filter_name, quality, jpeg_original, **marks, quantization=tables))
     for filter_name in dict.fromkeys(c.filter_name for c in cases):
         spec = TOOL_FILTERS[filter_name]
         tool = TOOLS[spec.tool]

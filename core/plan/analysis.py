@@ -61,7 +61,7 @@ All of it runs once, in NumPy, on a central crop, before tiling, and results in 
 :class:`PairAnalysis` that ``aarecovery.plan.make_plan`` turns into the backends' Plan.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..backends.base import Decision
 from ..colour import linear_to_srgb
@@ -72,7 +72,7 @@ from ..spec.sobel import gradient_magnitude
 from .blend_space import choose_blend_space
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
-from .compression import (COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SMOOTHED_STRENGTH, compression_evidence,
+from .compression import (COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SMOOTHED_STRENGTH, GRID_MARGIN, compression_evidence,
                           hidden_compression)
 from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
@@ -296,10 +296,16 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # (q 98) under GEGL's unsharp mask 0 -> 0.60; no other case moved. Not for point-wise
     # filters: there the star burst (q 98) under GEGL's exposure went from 0.17 to -0.30
     # (1.14 dB worse than F) at the compressed branch's calibrated strength.
-    if textured and not compression.compressed:
+    # A JPEG file's tables say how much noise, not where its blocks lie: where the pixels did
+    # not show the grid either, the flattest phase places them. Tuning half with the tables
+    # given (eval --jpeg-tables), the three cases above went back to F (serif and star burst
+    # at q 98 under GEGL's unsharp mask, serif under G'MIC's bilateral) with the grid's
+    # guessed phase.
+    phase_unknown = compression.source == "quantization tables" and compression.margin < GRID_MARGIN
+    if textured and (not compression.compressed or phase_unknown):
         hidden = hidden_compression(o)
         if hidden.compressed:
-            compression = hidden
+            compression = hidden if not compression.compressed else replace(compression, phase=hidden.phase)
             textured, texture = is_textured(o, fit, compression)
     colour_map = fit_colour_map(o, f, edges) if textured else None
     # A comic's screentone reads as texture, but it is a drawing (plan/hatching.py): under a
