@@ -296,11 +296,11 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # (q 98) under GEGL's unsharp mask 0 -> 0.60; no other case moved. Not for point-wise
     # filters: there the star burst (q 98) under GEGL's exposure went from 0.17 to -0.30
     # (1.14 dB worse than F) at the compressed branch's calibrated strength.
-    # A JPEG file's tables say how much noise, not where its blocks lie: where the pixels did
-    # not show the grid either, the flattest phase places them. Tuning half with the tables
-    # given (eval --jpeg-tables), the three cases above went back to F (serif and star burst
-    # at q 98 under GEGL's unsharp mask, serif under G'MIC's bilateral) with the grid's
-    # guessed phase.
+    # The same where a JPEG file's tables are the evidence but the pixels did not show the
+    # grid: the tables say how much noise, not where the blocks lie, and the flattest phase
+    # places them. Tuning half with the tables given (eval --jpeg-tables), those serif and star
+    # burst cases kept F at the grid's guessed phase; at the flattest they gain as from the
+    # pixels, and no other case moved.
     phase_unknown = compression.source == "quantization tables" and compression.margin < GRID_MARGIN
     if textured and (not compression.compressed or phase_unknown):
         hidden = hidden_compression(o)

@@ -338,8 +338,9 @@ def hidden_compression(encoded):
     blocks): serif 0.00-0.05, the star burst 0.00-0.17; the camera's portrait, coffee,
     Hubble and the screenshot 0.94-1.00 (the maps, icons, manga, handwriting, poster and
     scans have fewer than 16 at this size).
-    The caller asks only where O read as textured without other evidence of compression: a
-    lossless drawing has flat blocks too, and reads as hard-edged before.
+    The caller asks only where O read as textured and no grid was seen in its pixels (no
+    evidence of compression, or a JPEG file's tables, which give the noise but not the
+    phase): a lossless drawing has flat blocks too, and reads as hard-edged before.
 
     Parameters
     ----------
