@@ -1,5 +1,8 @@
 """Choosing how the GL backend runs its passes: ``gl_path`` in the API and on the command line."""
 
+import os
+import subprocess
+import sys
 from types import SimpleNamespace
 
 import numpy as np
@@ -72,3 +75,46 @@ def test_command_line_gl_path(tmp_path, capsys):
                    "--backend", "numpy", "--gl-path", "compute"])
     err = capsys.readouterr().err
     assert status == 1 and err.startswith("aarecovery: error: ") and len(err.splitlines()) == 1
+
+
+@pytest.mark.gl
+def test_the_context_is_asked_for_gl_4_3_first(monkeypatch):
+    # NVIDIA's EGL makes exactly the version asked for: asked for 3.3, an H100 gave 3.3 and
+    # the engine ran the fragment path only (0.15 GP/s where compute runs 0.84). Mesa makes
+    # its newest either way, so the request itself is what this checks, through the driver.
+    import moderngl
+    from aarecovery.backends.gl import context as gl_context
+    asked = []
+    real = moderngl.create_standalone_context
+
+    def recording(**options):
+        asked.append(options.get("require"))
+        return real(**options)
+
+    monkeypatch.setattr(gl_context.moderngl, "create_standalone_context", recording)
+    made = gl_context.create_context()
+    try:
+        assert asked[0] == 430 and made.version_code >= 430
+    finally:
+        made.release()
+
+
+def _in_child(script, **environment):
+    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, **environment})
+
+
+@pytest.mark.gl
+def test_a_driver_without_gl_4_3_still_gives_a_context_for_the_fragment_path():
+    # Mesa told to offer OpenGL 4.0 at most: the request for 4.3 fails in the driver, 3.3
+    # follows, and the engine runs its fragment path.
+    renderer = _in_child("from aarecovery.backends.gl.context import create_context as c; "
+                         "print(c().info['GL_RENDERER'])").stdout
+    if "llvmpipe" not in renderer:
+        pytest.skip(f"MESA_GL_VERSION_OVERRIDE needs Mesa's llvmpipe; this GL is {renderer.strip()!r}")
+    done = _in_child("from aarecovery.backends.gl.context import create_context; "
+                     "from aarecovery.backends.gl.paths import available_paths; "
+                     "c = create_context(); print(c.version_code, available_paths(c))",
+                     MESA_GL_VERSION_OVERRIDE="4.0")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split()[0] == "400" and "('fragment',)" in done.stdout, done.stdout

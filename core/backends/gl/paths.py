@@ -13,16 +13,19 @@ Which path ``"auto"`` runs (:func:`choose_path`), measured:
   377 ms thresholded, 540 ms against 1413 ms under gamma (every pixel fitted). llvmpipe
   shades fragments in 2x2 quads on its rasterizer threads; a compute work group is a loop
   over its invocations.
-* NVIDIA H100 (GL 4.6, a prototype of the same per-pixel work at 3840 x 2160): the compute
-  path, 9.9 GP/s with RGBA32F textures against 0.53 GP/s for fragment passes; data-centre
-  GPUs give fragment shading only a few of their units.
+* NVIDIA H100 (GL 4.3 through EGL, this product's passes, ``aarecovery bench``, classify and
+  passes of the safe default at 3840 x 2160): the compute path, 837 MP/s against 151 MP/s
+  for the fragment passes under gamma (every pixel fitted), 3.1 GP/s against 0.20 GP/s
+  thresholded; data-centre GPUs give fragment shading only a few of their units.
 
 Other GPUs were not measured; compute is the rule wherever GL 4.3 is offered by a GPU.
 A shared-memory tile for the fit's neighbourhoods (``SHARED_TILE`` in
 ``fit_blend_model.comp``) made the fit 1.6x slower on llvmpipe (0.92 s against 0.56 s of CPU,
-2048 x 2048 under gamma: barriers are expensive there) and has not been measured on a GPU,
-whose texture cache serves a 3x3 neighbourhood; it is off (``GLBackend.shared_tile``) until
-a device measures faster with it (``aarecovery bench`` times both).
+2048 x 2048 under gamma: barriers are expensive there). On the H100 it changed nothing at
+3840 x 2160 (810 against 837 MP/s under gamma, the fit pass alone 1.25 against 0.71 ms) and
+helped only at 4096 x 4096 under gamma (743 against 458 MP/s), where every pass ran several
+times slower per pixel than at 3840 x 2160 for a reason not found (docs/performance.md); it
+stays off (``GLBackend.shared_tile``; ``aarecovery bench`` times both).
 """
 
 import moderngl
@@ -30,13 +33,12 @@ import moderngl
 from ...errors import InputError
 from ...params import GL_PATHS
 from .blocks import BLOCK_SIDE
+from .context import COMPUTE_VERSION
 from .glsl import load_source
 
 __all__ = ["COMPUTE_VERSION", "SAMPLER_UNITS", "FragmentPath", "ComputePath", "choose_path",
            "available_paths", "software_renderer"]
 
-#: The first GL version with compute shaders, storage buffers and indirect dispatch.
-COMPUTE_VERSION = 430
 #: The texture unit of every sampler uniform the passes declare.
 SAMPLER_UNITS = {"original_image": 0, "filtered_image": 1, "model_map": 2, "previous_iterate": 3,
                  "original_work": 4, "filtered_work": 5, "transfer_table": 6, "jacobi_constant_map": 7,
