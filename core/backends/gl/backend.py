@@ -84,14 +84,23 @@ def _current(method):
 
     Several standalone contexts may live in one process (an engine per thread, a test's
     second engine); creating or releasing one changes which is current. A borrowed context
-    belongs to its window, whose owner keeps it current.
+    belongs to its window, whose owner keeps it current; every call leaves its bound
+    framebuffer as it found it. The classification, the copy of F and the readback bind
+    the engine's own framebuffers, which a new image size releases: saved only around the
+    passes, the next call restored a released one (an AttributeError from moderngl).
     """
     @functools.wraps(method)
     def wrapper(self, *args, **kwargs):
-        if not self._owns_context:
+        if self._owns_context:
+            with self.context:
+                return method(self, *args, **kwargs)
+        previous = self.context.fbo
+        try:
             return method(self, *args, **kwargs)
-        with self.context:
-            return method(self, *args, **kwargs)
+        finally:
+            # One its owner released meanwhile is not ours to bind.
+            if previous is not None and not isinstance(previous.mglo, moderngl.mgl.InvalidObject):
+                previous.use()
     return wrapper
 
 
@@ -308,17 +317,10 @@ class GLBackend:
         return self._framebuffers[key]
 
     # -- passes -----------------------------------------------------------------------------
-    @contextlib.contextmanager
     def _passes(self):
-        """Blending and depth tests off for the passes; a borrowed context's framebuffer and
-        enable flags as they were afterwards."""
-        previous = None if self._owns_context else self.context.fbo
-        try:
-            with self.context.scope(self._framebuffer([self._textures["result"]]), enable_only=moderngl.NOTHING):
-                yield
-        finally:
-            if previous is not None:
-                previous.use()
+        """Blending and depth tests off for the passes; a borrowed context's enable flags as
+        they were afterwards (its framebuffer: ``_current``)."""
+        return self.context.scope(self._framebuffer([self._textures["result"]]), enable_only=moderngl.NOTHING)
 
     def _to_working_space(self, lists=None, list_name=None):
         """O and F into the working textures, over a block list or (`lists` None) everywhere."""
