@@ -8,7 +8,7 @@ import pytest
 from aarecovery import colour
 from aarecovery.backends.gl import blocks
 from aarecovery.backends.gl.glsl import read_source
-from aarecovery.spec import blend_model, local_plan, pure_colours
+from aarecovery.spec import blend_model, local_plan, pure_colours, working_space
 
 # (shader file, GLSL name) -> the value the NumPy specification uses.
 TWINS = {
@@ -32,6 +32,7 @@ TWINS = {
     ("local_plan.glsl", "INK_DARK"): local_plan.INK_DARK,
     ("local_plan.glsl", "INK_SHARE_LOW"): local_plan.INK_SHARE_LOW,
     ("local_plan.glsl", "INK_SHARE_HIGH"): local_plan.INK_SHARE_HIGH,
+    ("working.glsl", "VISIBLE_COVERAGE"): working_space.VISIBLE_COVERAGE,
     ("blend_model.glsl", "TINY"): float(blend_model._TINY),
     ("blend_model.glsl", "FAINT"): float(blend_model._FAINT),
     ("blend_model.glsl", "SPREAD_TIE"): float(blend_model.SPREAD_TIE),

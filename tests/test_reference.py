@@ -104,3 +104,19 @@ def test_linear_input_matches_encoded_input(backend):
     lin_o, lin_f = (srgb_to_linear(x / np.float32(255)) for x in (original, filtered))
     linear = recover(lin_o, lin_f, backend, mode="paper", linear=True)
     assert np.abs(to_uint8(linear_to_srgb(linear)).astype(int) - encoded).max() <= 1
+
+
+def test_a_coverage_no_output_can_show_keeps_fs_colour():
+    # Coverage 1e-6 is the rounding of a transparent pixel's blend with an opaque neighbour
+    # (model alpha 1 - 4e-6 on an H100, exactly 1 in NumPy): its colour, the neighbour's, is a
+    # ratio of rounding errors. Such a pixel comes back transparent in F's colour.
+    from aarecovery.spec import from_working_space
+    from aarecovery.spec.working_space import VISIBLE_COVERAGE
+    filtered = np.array([[[0.0, 0.667, 0.0, 0.0], [0.2, 0.4, 0.6, 1.0]]], np.float32)
+    work = np.array([[[0.667e-6, 0.667e-6, 1e-6, 1e-6], [0.2, 0.4, 0.6, 1.0]]], np.float32)
+    result = from_working_space(work, filtered, blend_space="srgb")
+    np.testing.assert_array_equal(result[0, 0], filtered[0, 0])
+    np.testing.assert_allclose(result[0, 1], filtered[0, 1], atol=1e-7)
+    work[0, 0] = (0.0, 0.5 * 2 * VISIBLE_COVERAGE, 0.0, 2 * VISIBLE_COVERAGE)
+    visible = from_working_space(work, filtered, blend_space="srgb")[0, 0]
+    np.testing.assert_allclose(visible, (0.0, 0.5, 0.0, 2 * VISIBLE_COVERAGE), atol=1e-6)

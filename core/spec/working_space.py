@@ -10,7 +10,15 @@ import numpy as np
 
 from ..colour import linear_to_srgb, srgb_to_linear
 
-__all__ = ["to_working_space", "from_working_space"]
+__all__ = ["to_working_space", "from_working_space", "VISIBLE_COVERAGE"]
+
+#: A result's coverage at or below this is none: the pixel comes back transparent with F's
+#: colour. Half a 16-bit level, so no integer output can show it. Below it the colour is the
+#: ratio of two rounding errors: where the model's alpha is 1 exactly in NumPy and 1 - 4e-6
+#: on an NVIDIA H100 (fused multiply-adds), a transparent pixel took 4e-6 of an opaque
+#: neighbour and came back in that neighbour's colour at coverage 1e-6 (255 levels apart
+#: in 8-bit colour, measured; both backends now return F's colour there).
+VISIBLE_COVERAGE = 0.5 / 65535
 
 
 def to_working_space(rgba, *, linear_input=False, blend_space="linear"):
@@ -47,8 +55,9 @@ def from_working_space(work, filtered_rgba, *, linear_input=False, blend_space="
     work : ndarray of float32, shape (H, W, 4)
         Premultiplied RGBA in the blend space.
     filtered_rgba : ndarray of float32, shape (H, W, 4)
-        F in its own encoding; its colour is kept where the result is fully transparent,
-        where colour cannot be recovered from a premultiplied value.
+        F in its own encoding; its colour is kept where the result is transparent (coverage
+        at most :data:`VISIBLE_COVERAGE`), where colour cannot be recovered from a
+        premultiplied value.
     linear_input, blend_space
         As given to :func:`to_working_space`.
     filtered_work : ndarray of float32, shape (H, W, 4), optional
@@ -62,7 +71,8 @@ def from_working_space(work, filtered_rgba, *, linear_input=False, blend_space="
         Straight RGBA in the input's encoding, clipped to [0, 1].
     """
     alpha = np.clip(work[..., 3:4], 0, 1)
-    visible = alpha > 0
+    visible = alpha > np.float32(VISIBLE_COVERAGE)
+    alpha = np.where(visible, alpha, np.float32(0))
     colour = np.where(visible, work[..., :3] / np.where(visible, alpha, 1), 0)
     colour = np.clip(colour, 0, 1)
     if blend_space == "linear" and not linear_input:

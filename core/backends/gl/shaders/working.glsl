@@ -20,7 +20,11 @@ vec4 filtered_neighbour(ivec2 p, int i, ivec2 size) {
 }
 #endif
 
-// Straight RGBA in the input encoding; a fully transparent result keeps F's colour, and a
+// A result's coverage at or below this is none (twin: VISIBLE_COVERAGE in working_space.py,
+// which says why).
+const float VISIBLE_COVERAGE = 0.5 / 65535.0;
+
+// Straight RGBA in the input encoding; a transparent result keeps F's colour, and a
 // pixel the recovery left exactly at F keeps F bit for bit (decode + encode is not exact).
 vec4 from_working(vec4 work, ivec2 p) {
 #if EXACT_UNTOUCHED
@@ -28,7 +32,7 @@ vec4 from_working(vec4 work, ivec2 p) {
     if (work == texelFetch(filtered_work, p, 0)) return clamp(texelFetch(filtered_image, p, 0), 0.0, 1.0);
 #endif
     float coverage = clamp(work.a, 0.0, 1.0);
-    if (coverage > 0.0) {
+    if (coverage > VISIBLE_COVERAGE) {
         vec3 colour = clamp(work.rgb / coverage, 0.0, 1.0);
         return vec4(convert_colour(colour, OUTPUT_CONVERT), coverage);
     }
