@@ -86,7 +86,11 @@ RIDGE_MARGIN = 0.1001
 #: in-low 0.3 in-high 0.4: up to 0.13 of yellow in 88 black pixels; none now). Measured:
 #: real-tools tuning half, drawings with PNG originals 0.606 -> 0.643; built-in quick suite
 #: linear 0.781 -> 0.766, sRGB 0.762 -> 0.781; full 0.791 -> 0.774, 0.805 -> 0.812.
-MIN_REACH = 1.2
+#: 1.2001, not 1.2, as RIDGE_MARGIN: box-filtered coverages reach exactly 1.2 ((1 - 4/16) /
+#: (14/16 - 4/16), the text scene in linear light), and rounding then decided the test,
+#: differently on an NVIDIA H100 and in NumPy (R 0.045 apart after one iteration). Built-in
+#: suite: two text cases +0.001, the means unchanged; real-tools quick tuning half unchanged.
+MIN_REACH = 1.2001
 # The table must reproduce F at the observed extreme within this (working space).
 EXPLAIN_TOLERANCE = 0.02
 #: Without a fitted table (a neighbourhood filter that keeps flat colours), F at the extreme

@@ -49,7 +49,7 @@ const float KEPT_CONTRAST = 0.5;
 const float RANGE_TOLERANCE = 0.05;
 const float END_TOLERANCE = 1.0 / 255.0;
 const float MIN_CONTRAST = 8.5 / 255.0;
-const float MIN_REACH = 1.2;
+const float MIN_REACH = 1.2001;
 
 float table_at(float key, int channel) {
     // Linear interpolation between bin centres, two fetches (no texture filtering: llvmpipe's
