@@ -59,3 +59,20 @@ def test_the_factor_is_the_specifications_in_every_active_block(bars_over_photo,
         # pixels the factor depends on them.
         assert np.abs(numpy_maps.strength[active] - 1).max() > 0.3, name
         np.testing.assert_allclose(factor[active], numpy_maps.strength[active], atol=_FACTOR_TOLERANCE, err_msg=name)
+
+
+def test_equally_bright_extremes_tie_whatever_the_rounding(bars_over_photo):
+    # Beside the bars, (233, 231, 236) and (233, 230, 237) are a 3 x 3 neighbourhood's
+    # brightest by their channel sums, which are equal: the extreme must not be decided by
+    # how 8-bit values became floats (u8 / 255 here, u8 * (1 / 255) there, a GPU's unorm
+    # conversion), which moved the factor by 0.0026 (an NVIDIA H100 against NumPy).
+    from aarecovery.spec.local_plan import LocalStrength
+    original = np.rint(bars_over_photo.original * 255).astype(np.uint8)
+    local = LocalStrength(textured=0.5)
+    divided = local.factor(original / np.float32(255))
+    multiplied = local.factor(original * np.float32(1 / 255))
+    # Float rounding of the same choice moves it by a few 1e-7.
+    np.testing.assert_allclose(divided, multiplied, rtol=0, atol=1e-6)
+    rows, cols = np.nonzero(np.ones(original.shape[:2], bool))
+    np.testing.assert_array_equal(local.factor_at(original * np.float32(1 / 255), rows, cols),
+                                  multiplied.ravel())

@@ -30,6 +30,7 @@ TWINS = {
     ("local_plan.glsl", "INK_REPEATS"): local_plan.INK_REPEATS,
     ("local_plan.glsl", "INK_NEAR_SPAN"): local_plan.INK_NEAR_SPAN,
     ("local_plan.glsl", "INK_DARK"): local_plan.INK_DARK,
+    ("local_plan.glsl", "INK_TIE"): local_plan.INK_TIE,
     ("local_plan.glsl", "INK_SHARE_LOW"): local_plan.INK_SHARE_LOW,
     ("local_plan.glsl", "INK_SHARE_HIGH"): local_plan.INK_SHARE_HIGH,
     ("working.glsl", "VISIBLE_COVERAGE"): working_space.VISIBLE_COVERAGE,

@@ -113,7 +113,9 @@ def test_gl_computes_the_same_strength_map_as_numpy(banner_over_photo, gl_path):
         (numpy_result, numpy_maps), (gl_result, gl_maps) = results["numpy"], results["gl"]
         np.testing.assert_allclose(gl_maps.strength, numpy_maps.strength, atol=_FACTOR_TOLERANCE, err_msg=name)
         assert np.abs(numpy_maps.strength - plan.local.textured).max() > 0.3, name
-        np.testing.assert_allclose(gl_maps.beta, numpy_maps.beta, atol=1e-5, err_msg=name)
+        # Beta within the parity table's tolerance: an H100's edge strength differed by 4e-5
+        # of itself at one pixel, and beta by 1.8e-5 (llvmpipe: 5e-6).
+        np.testing.assert_allclose(gl_maps.beta, numpy_maps.beta, atol=parity.MAPS["beta"], err_msg=name)
         # The stated tolerances of the parity tests: one 8-bit level, 1e-5 on float.
         np.testing.assert_allclose(gl_result.astype(np.float64), numpy_result, atol=1 if name == "uint8" else 1e-5,
                                    err_msg=name)

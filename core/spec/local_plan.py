@@ -64,7 +64,7 @@ from ..colour import linear_to_srgb
 __all__ = ["LocalStrength", "encoded_colour", "strength_map", "flat_pixels", "flat_share", "hard_edged_weight",
            "ink_weight", "ink_weight_at", "REACH", "REGION_RADIUS", "TEXTURED_SHARE", "HARD_EDGED_SHARE", "INK_RADIUS",
            "INK_REPEATS",
-           "INK_NEAR_SPAN", "INK_DARK", "INK_SHARE_LOW", "INK_SHARE_HIGH"]
+           "INK_NEAR_SPAN", "INK_DARK", "INK_TIE", "INK_SHARE_LOW", "INK_SHARE_HIGH"]
 
 #: A pixel is flat when its 3 x 3 neighbourhood spans at most this in every channel: equal
 #: 8-bit values (the 8-bit grid is 1/255 apart).
@@ -84,6 +84,13 @@ INK_REPEATS = 3
 INK_NEAR_SPAN = 3.5 / 255
 #: Ink whose brightest channel is at most this is no evidence (a camera's clipped shadows).
 INK_DARK = 5.0 / 255
+#: Two colours of a 3 x 3 neighbourhood whose channel sums differ by at most this are equally
+#: bright (or dark): the first in row order is the extreme. A quarter of an 8-bit level, so
+#: that 8-bit colours with equal sums, (233, 231, 236) and (233, 230, 237), tie whatever the
+#: rounding of their float sums: decided by the last bit, NumPy (u8 / 255) and an NVIDIA H100
+#: (its unorm conversion) took different extremes, and the factor differed by 0.0026 (a
+#: photo's pixel beside posterized bars, measured).
+INK_TIE = 0.25 / 255
 #: The pixel's share of the ink (its place from the other extreme, 0, to the ink, 1) from
 #: which the weight rises, and at which it is full: a smoothstep between.
 INK_SHARE_LOW = 0.3
@@ -141,8 +148,8 @@ def ink_weight(encoded):
     colour), 0 where it holds none, smooth in the pixel's share of the ink.
 
     The extremes are the brightest and darkest of the 3 x 3 neighbourhood by the sum of the
-    channels (the first in row order on ties); each is tested as ink on its own, and the
-    larger weight counts.
+    channels (the first in row order among sums within :data:`INK_TIE`); each is tested as
+    ink on its own, and the larger weight counts.
 
     Parameters
     ----------
@@ -169,13 +176,9 @@ def ink_weight_at(encoded, rows, cols):
     encoded = np.asarray(encoded, np.float32)
     rows, cols = np.asarray(rows, np.intp), np.asarray(cols, np.intp)
     replicated = np.pad(encoded, ((1, 1), (1, 1), (0, 0)), mode="edge")
-    # (9, K, 3), row by row as _extremes visits them; argmax and argmin take the first of
-    # equals, as its strict comparisons keep the first.
-    square = np.stack([replicated[rows + dy, cols + dx] for dy in range(3) for dx in range(3)])
-    brightness = square[..., 0] + square[..., 1] + square[..., 2]
-    picked = np.arange(rows.size)
-    extremes = tuple(np.ascontiguousarray(square[index, picked].T)
-                     for index in (brightness.argmax(axis=0), brightness.argmin(axis=0)))
+    # Row by row, as _extremes visits them.
+    extremes = _pick_extremes(np.ascontiguousarray(replicated[rows + dy, cols + dx].T)
+                              for dy in range(3) for dx in range(3))
     radius = INK_RADIUS
     outside = np.pad(encoded, ((radius, radius), (radius, radius), (0, 0)), constant_values=np.nan)
     counts = [(np.zeros(rows.size, np.int32), np.zeros(rows.size, np.int32)) for _ in extremes]
@@ -208,20 +211,27 @@ def _ink_weight(planes, extremes, recurrences):
 
 def _extremes(planes):
     """The brightest and darkest colour ``(3, H, W)`` of each 3 x 3 neighbourhood (borders
-    replicated), by the sum of the channels, the first in row order on ties."""
-    brightest, darkest = None, None
-    for colour in _shifted(np.moveaxis(planes, 0, -1), 1):
-        colour = np.moveaxis(colour, -1, 0)
+    replicated), by the sum of the channels, the first in row order among sums within
+    :data:`INK_TIE`."""
+    return _pick_extremes(np.moveaxis(colour, -1, 0) for colour in _shifted(np.moveaxis(planes, 0, -1), 1))
+
+
+def _pick_extremes(colours):
+    """The brightest and darkest of `colours` (planes ``(3, ...)`` in row order): a later
+    colour replaces the one kept only when its sum is more than :data:`INK_TIE` beyond it."""
+    tie = np.float32(INK_TIE)
+    brightest = darkest = None
+    for colour in colours:
         brightness = colour[0] + colour[1] + colour[2]
         if brightest is None:
             brightest, darkest = colour.copy(), colour.copy()
             high, low = brightness, brightness.copy()
             continue
-        higher, lower = brightness > high, brightness < low
+        higher, lower = brightness > high + tie, brightness < low - tie
         np.copyto(brightest, colour, where=higher)
         np.copyto(darkest, colour, where=lower)
-        np.maximum(high, brightness, out=high)
-        np.minimum(low, brightness, out=low)
+        np.copyto(high, brightness, where=higher)
+        np.copyto(low, brightness, where=lower)
     return brightest, darkest
 
 

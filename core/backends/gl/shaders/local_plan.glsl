@@ -13,6 +13,7 @@ const int INK_RADIUS = 3;
 const int INK_REPEATS = 3;
 const float INK_NEAR_SPAN = 3.5 / 255.0;
 const float INK_DARK = 5.0 / 255.0;
+const float INK_TIE = 0.25 / 255.0;
 const float INK_SHARE_LOW = 0.3;
 const float INK_SHARE_HIGH = 0.7;
 
@@ -41,8 +42,9 @@ float ink_weight(ivec2 p, ivec2 size) {
         for (int dx = -1; dx <= 1; ++dx) {
             vec3 c = original_encoded(p + ivec2(dx, dy), size);
             float b = c.r + c.g + c.b;
-            if (b > high) { high = b; brightest = c; }
-            if (b < low) { low = b; darkest = c; }
+            // Sums within INK_TIE tie: the first in row order stays (local_plan.py says why).
+            if (b > high + INK_TIE) { high = b; brightest = c; }
+            if (b < low - INK_TIE) { low = b; darkest = c; }
         }
     }
     // One read of the square counts both extremes' repeats (the counts are exact integers).
