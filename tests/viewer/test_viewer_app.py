@@ -397,3 +397,25 @@ def test_every_slider_label_is_drawn_whole_inside_the_panel(app, image_pair, tmp
         text = app.last_screenshot[top:bottom, left:right].min(axis=-1) > 200
         drawn = np.nonzero(text.any(axis=0))[0]
         assert drawn.size and drawn[-1] >= right - left - 3, (key, drawn[-1:], right - left)
+
+
+def test_the_window_asks_for_gl_4_3_first(monkeypatch):
+    # NVIDIA's drivers make exactly the version asked for, and the engine in the window runs
+    # its compute path only on 4.3: the window asks for it first (Mesa makes 4.5 either way).
+    require_viewer_extra()
+    import glfw
+    from aarecovery.viewer import window as viewer_window
+    asked = []
+    real = glfw.window_hint
+
+    def recording(hint, value):
+        if hint in (glfw.CONTEXT_VERSION_MAJOR, glfw.CONTEXT_VERSION_MINOR):
+            asked.append(value)
+        return real(hint, value)
+
+    monkeypatch.setattr(viewer_window.glfw, "window_hint", recording)
+    handle, context = viewer_window.open_window((64, 48), visible=False)
+    try:
+        assert asked[:2] == [4, 3] and context.version_code >= 430
+    finally:
+        viewer_window.close_window(handle, context)
