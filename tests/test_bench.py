@@ -80,3 +80,19 @@ def test_bench_process_without_numpy_runs_leaves_the_numpy_program_out(capsys):
     (pair,) = json.loads(capsys.readouterr().out)["process"]["pairs"]
     assert "numpy-paper" not in pair["rows"] and "numpy-paper/safe" not in pair["ratios"]
     assert {"safe", "paper"} <= set(pair["rows"]) and "safe/paper" in pair["ratios"]
+
+
+def test_bench_passes_times_each_gl_pass_on_its_own(capsys):
+    # Every pass of each mode, labelled, waited for: the device's time per pass (issue 21's
+    # "what bounds each figure" on a GPU, where issuing the passes costs more than running them).
+    status = main(["bench", "--sizes", "96x64", "--runs", "1", "--filters", "gamma", "--configs",
+                   "gl-compute,numpy", "--passes", "--json"])
+    assert status == 0
+    captured = capsys.readouterr()
+    (row,) = json.loads(captured.out)["results"]
+    passes = row["configs"]["gl-compute"]["passes_ms"]
+    assert set(passes) == {"paper", "safe"}
+    assert {"classify", "fit_blend_model", "jacobi_step", "jacobi_step (final)"} <= set(passes["paper"])
+    assert all(value > 0 for value in passes["paper"].values())
+    assert "passes_ms" not in row["configs"]["numpy"]
+    assert "gl-compute paper, each pass waited for (ms): classify" in captured.err

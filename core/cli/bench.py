@@ -54,7 +54,7 @@ def run(args):
     from ..lab.bench import run_bench
 
     report = run_bench([_size(size) for size in args.sizes.split(",")], _configs(args.configs),
-                       args.filters.split(","), args.runs, log=_log_to(args))
+                       args.filters.split(","), args.runs, passes=args.passes, log=_log_to(args))
     if args.json:
         _write_json(report, args.json)
     return 0
@@ -98,6 +98,9 @@ def register(subparsers):
     parser.add_argument("--filters", default="threshold,gamma",
                         help="threshold (flat F away from edges) and/or gamma (every pixel fitted); "
                              "default %(default)s")
+    parser.add_argument("--passes", action="store_true",
+                        help="also time each GL pass on its own, waited for before and after: the device's time "
+                             "per pass, for the paper's method and the safe default")
     parser.add_argument("--runs", type=int, default=5, help="timed runs per figure; NumPy gets a third "
                         "(default %(default)s)")
     parser.add_argument("--process", metavar="WxH", nargs="?", const="4096x4096",

@@ -149,6 +149,24 @@ def _stages(engine, original, filtered, plan, runs):
             for stage in ("upload", "classify", "passes", "readback")}
 
 
+def _passes(engine, original, filtered, plan, runs):
+    """Median milliseconds of each GL pass of ``run(plan)``, each waited for on its own
+    (``GLBackend.pass_clock``): the device's time per pass, without what issuing them costs."""
+    per_run = []
+    seconds = defaultdict(float)
+    engine._impl.pass_clock = lambda label, taken: seconds.__setitem__(label, seconds[label] + taken)
+    try:
+        for run in range(runs + 1):
+            seconds.clear()
+            engine.set_images(original, filtered, blend_space=plan.blend_space)
+            engine.run(plan)
+            if run:
+                per_run.append(dict(seconds))
+    finally:
+        engine._impl.pass_clock = None
+    return {label: statistics.median(times.get(label, 0.0) for times in per_run) * 1000 for label in per_run[0]}
+
+
 def _end_to_end(engine, original, filtered, plan, runs):
     def recover():
         engine.set_images(original, filtered, blend_space=plan.blend_space)
@@ -189,7 +207,13 @@ def _log_row(log, config, figures, pixels):
         f"{figures['safe_mps']:8.2f}")
 
 
-def run_bench(sizes, configs, filters, runs, *, log=print):
+def _log_passes(log, config, mode, milliseconds, pixels):
+    total = sum(milliseconds.values())
+    cells = ", ".join(f"{label} {value:.2f}" for label, value in milliseconds.items())
+    log(f"  {config} {mode}, each pass waited for (ms): {cells}; sum {total:.2f} ms, {pixels / total / 1e3:.1f} MP/s")
+
+
+def run_bench(sizes, configs, filters, runs, *, passes=False, log=print):
     """Measure every stage and configuration on generated pairs; return the report.
 
     Parameters
@@ -203,6 +227,10 @@ def run_bench(sizes, configs, filters, runs, *, log=print):
         ``"threshold"`` and/or ``"gamma"`` (see :func:`bench_image_pair`).
     runs : int
         Timed runs per figure after a warm-up; NumPy gets a third.
+    passes : bool
+        Also time each GL pass on its own, waited for before and after, for the paper's
+        method and the safe default (the device's time per pass: the stage figures add what
+        issuing the passes costs).
     log : callable
         Gets the report line by line.
 
@@ -212,7 +240,8 @@ def run_bench(sizes, configs, filters, runs, *, log=print):
         ``machine``, ``gl_renderer``, ``results`` (per filter and size: the decode, plan and
         encode seconds, and per configuration the stage seconds, the passes' megapixels per
         second (classify and passes) and end-to-end megapixels per second for the paper's
-        method and the safe default).
+        method and the safe default; with `passes`, ``passes_ms``: per mode each pass's
+        milliseconds).
     """
     from ..params import Parameters
     from ..plan import make_plan
@@ -254,6 +283,11 @@ def run_bench(sizes, configs, filters, runs, *, log=print):
                            "paper_mps": pixels / paper_seconds / 1e6, "safe_mps": pixels / safe_seconds / 1e6}
                 row["configs"][config] = figures
                 _log_row(log, config, figures, pixels)
+                if passes and engine.backend == "gl":
+                    figures["passes_ms"] = {mode: _passes(engine, original, filtered, plan, timed)
+                                            for mode, plan in (("paper", paper), ("safe", safe))}
+                    for mode, milliseconds in figures["passes_ms"].items():
+                        _log_passes(log, config, mode, milliseconds, pixels)
             report["results"].append(row)
     for engine in engines.values():
         engine.release()

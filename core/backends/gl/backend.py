@@ -37,6 +37,7 @@ tile the same size, ``aarecovery.tiling``); the result texture has F's bit depth
 
 import contextlib
 import functools
+import time
 from collections import namedtuple
 
 import moderngl
@@ -166,6 +167,10 @@ class GLBackend:
         #: None, or a callable that ``aarecovery bench`` gives to time the stages: called with
         #: "upload", "classify" or "passes" once the work of that stage is finished.
         self.stage_clock = None
+        #: None, or a callable that ``aarecovery bench --passes`` gives to time each pass on
+        #: its own: called with the pass's label and its seconds, the context finished
+        #: before and after it (the device's time for that pass, and the wait).
+        self.pass_clock = None
         self._classifier = BlockClassifier(self.context, compute="compute" in self.capabilities.gl_paths,
                                            runs=path == "fragment")
         self._textures = {}
@@ -238,6 +243,24 @@ class GLBackend:
                                      and not o_layout.alpha and not f_layout.alpha)
         return o_dtype, f_dtype
 
+    def _timed(self, label, work):
+        """Run `work()`, a pass or a copy on the GPU; with a pass clock, waited for and timed."""
+        if self.pass_clock is None:
+            return work()
+        self.context.finish()
+        start = time.perf_counter()
+        work()
+        self.context.finish()
+        self.pass_clock(label, time.perf_counter() - start)
+
+    def _run_pass(self, shader, inputs, outputs, **options):
+        """One pass on the chosen path (``paths.py``), labelled for the pass clock."""
+        defines = options.get("defines") or {}
+        details = [f"pass {defines['LOCAL_PASS']}"] if "LOCAL_PASS" in defines else []
+        details += ["final"] if defines.get("FINAL") else []
+        label = shader + (f" ({', '.join(details)})" if details else "")
+        self._timed(label, lambda: self._path.run_pass(shader, inputs, outputs, **options))
+
     def _stage(self, name):
         if self.stage_clock is not None:
             self.context.finish()
@@ -265,7 +288,7 @@ class GLBackend:
                 lists.release()
             lists = self._lists[name] = BlockLists(self.context, grid)
         if name not in self._classified:
-            self._classifier.classify(self._textures[name], lists)
+            self._timed("classify", lambda: self._classifier.classify(self._textures[name], lists))
             self._classified.add(name)
         return lists
 
@@ -327,7 +350,7 @@ class GLBackend:
         original_work, filtered_work = self._working_textures()
         if self._uploads_are_working:
             return
-        self._path.run_pass("to_working_space", {"original_image": self._textures["original"],
+        self._run_pass("to_working_space", {"original_image": self._textures["original"],
                                                  "filtered_image": self._textures["filtered"]},
                             [original_work, filtered_work], blocks=lists, list_name=list_name,
                             defines=self._defines)
@@ -371,12 +394,12 @@ class GLBackend:
             if self._result_is_filtered_format:
                 # A copy (a memcpy on llvmpipe: 10 ms against 110 ms for keep_filtered over
                 # the inactive 85% of a 4096 x 4096 threshold pair, CPU time).
-                self.context.copy_framebuffer(self._framebuffer([result]),
-                                              self._framebuffer([self._textures["filtered"]]))
+                self._timed("copy of F", lambda: self.context.copy_framebuffer(
+                    self._framebuffer([result]), self._framebuffer([self._textures["filtered"]])))
             elif plan.iterations == 0:
-                self._path.run_pass("keep_filtered", keep, [result], defines=defines)
+                self._run_pass("keep_filtered", keep, [result], defines=defines)
             else:
-                self._path.run_pass("keep_filtered", keep, [result], blocks=lists, list_name="inactive",
+                self._run_pass("keep_filtered", keep, [result], blocks=lists, list_name="inactive",
                                     defines=defines)
             if plan.iterations > 0:
                 self._jacobi_steps(sources, defines, lists, plan.iterations)
@@ -404,7 +427,7 @@ class GLBackend:
         for number, (inputs, output, list_name) in enumerate(steps, 1):
             where = {} if blocks is None else {"blocks": blocks[0], "list_name": list_name}
             uniforms = {"textured": local.textured, "drawn_ink": int(local.drawn_ink)}
-            self._path.run_pass("local_plan", inputs, [self._work(output)], uniforms=uniforms,
+            self._run_pass("local_plan", inputs, [self._work(output)], uniforms=uniforms,
                                 defines={**defines, "LOCAL_PASS": number}, **where)
         self._factor_for = (local, blocks and blocks[1])
 
@@ -453,7 +476,7 @@ class GLBackend:
         if pure:
             outputs.append(self._work("jacobi_constant"))
             locations = dict(CONSTANT_LOCATION=2 + int(maps))
-        self._path.run_pass("fit_blend_model", sources, outputs, blocks=lists, list_name="active", uniforms=uniforms,
+        self._run_pass("fit_blend_model", sources, outputs, blocks=lists, list_name="active", uniforms=uniforms,
                             defines={**defines, "MAPS": int(maps), "SHARED_TILE": int(self.shared_tile), **locations})
 
     def _jacobi_steps(self, sources, defines, lists, iterations):
@@ -473,7 +496,7 @@ class GLBackend:
                 target = self._textures["result"]
             else:
                 target = self._work("iterate_b" if previous is self._textures.get("iterate_a") else "iterate_a")
-            self._path.run_pass("jacobi_step", {**inputs, "previous_iterate": previous}, [target], blocks=lists,
+            self._run_pass("jacobi_step", {**inputs, "previous_iterate": previous}, [target], blocks=lists,
                                 list_name="active", defines={**defines, "FINAL": int(final)})
             previous = target
 
