@@ -351,9 +351,9 @@ class GLBackend:
         if self._uploads_are_working:
             return
         self._run_pass("to_working_space", {"original_image": self._textures["original"],
-                                                 "filtered_image": self._textures["filtered"]},
-                            [original_work, filtered_work], blocks=lists, list_name=list_name,
-                            defines=self._defines)
+                                           "filtered_image": self._textures["filtered"]},
+                      [original_work, filtered_work], blocks=lists, list_name=list_name,
+                      defines=self._defines)
 
     @_current
     def run(self, plan, maps):
@@ -400,7 +400,7 @@ class GLBackend:
                 self._run_pass("keep_filtered", keep, [result], defines=defines)
             else:
                 self._run_pass("keep_filtered", keep, [result], blocks=lists, list_name="inactive",
-                                    defines=defines)
+                              defines=defines)
             if plan.iterations > 0:
                 self._jacobi_steps(sources, defines, lists, plan.iterations)
         self._stage("passes")
@@ -428,7 +428,7 @@ class GLBackend:
             where = {} if blocks is None else {"blocks": blocks[0], "list_name": list_name}
             uniforms = {"textured": local.textured, "drawn_ink": int(local.drawn_ink)}
             self._run_pass("local_plan", inputs, [self._work(output)], uniforms=uniforms,
-                                defines={**defines, "LOCAL_PASS": number}, **where)
+                          defines={**defines, "LOCAL_PASS": number}, **where)
         self._factor_for = (local, blocks and blocks[1])
 
     def _strength_map(self, plan):
@@ -477,7 +477,7 @@ class GLBackend:
             outputs.append(self._work("jacobi_constant"))
             locations = dict(CONSTANT_LOCATION=2 + int(maps))
         self._run_pass("fit_blend_model", sources, outputs, blocks=lists, list_name="active", uniforms=uniforms,
-                            defines={**defines, "MAPS": int(maps), "SHARED_TILE": int(self.shared_tile), **locations})
+                      defines={**defines, "MAPS": int(maps), "SHARED_TILE": int(self.shared_tile), **locations})
 
     def _jacobi_steps(self, sources, defines, lists, iterations):
         """Iterations 2..n ping-pong between two textures; the last writes the result.
@@ -497,7 +497,7 @@ class GLBackend:
             else:
                 target = self._work("iterate_b" if previous is self._textures.get("iterate_a") else "iterate_a")
             self._run_pass("jacobi_step", {**inputs, "previous_iterate": previous}, [target], blocks=lists,
-                                list_name="active", defines={**defines, "FINAL": int(final)})
+                          list_name="active", defines={**defines, "FINAL": int(final)})
             previous = target
 
     @_current
