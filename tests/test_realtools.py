@@ -385,3 +385,36 @@ def test_safe_default_on_the_held_out_quick_suite():
     assert set(summary["behind_peers"]) <= {"gegl-bilateral"}, summary["behind_peers"]
     assert summary["photo_pointwise"]["R"] >= 0.22, summary["photo_pointwise"]
     assert summary["jpeg_gain_kept"]["q>=85"]["R"][0] >= 0.35, summary["jpeg_gain_kept"]["q>=85"]
+
+
+@pytest.mark.parametrize("family, filter_name", [("text", "pil-ycbcr-equalize"), ("memo", "pil-ycbcr-equalize")])
+def test_a_tool_with_per_image_state_maps_the_scene_with_os_state(family, filter_name):
+    # The reference is the user's filter, the histogram of O, applied to the scene: where the
+    # scene's colours all appear in O, the reference is the box filter of the scene mapped as F
+    # maps O's pixels of those colours. The scene's own histogram gives another map.
+    from aarecovery.plan.resample import box_downsample
+    suite = realtools.RealToolsSuite("state", (family,), (filter_name,), 32, {family: ("srgb",)})
+    case, twin = realtools.build_cases(suite, "tune")
+    scene, _ = realtools.render_scene(family, 32)
+    k = realtools.FAMILIES[family].k
+
+    def packed(image):
+        values = np.rint(np.clip(image, 0, 1) * 255).astype(np.int64)
+        return (values[..., 0] << 16) | (values[..., 1] << 8) | values[..., 2]
+
+    in_scene, in_o = packed(scene), packed(case.original)
+    mapped = np.zeros(scene.shape, np.float32)
+    known = np.zeros(in_scene.shape, bool)
+    for colour in np.unique(in_o):
+        where = in_scene == colour
+        mapped[where] = case.filtered[in_o == colour][0]
+        known |= where
+    blocks = known.reshape(known.shape[0] // k, k, known.shape[1] // k, k).all(axis=(1, 3))
+    assert blocks.mean() > 0.5
+    expected = box_downsample(mapped, k, case.space)
+    np.testing.assert_allclose(case.reference[blocks], expected[blocks], atol=1e-6)
+    spec = realtools.TOOL_FILTERS[filter_name]
+    own_state = box_downsample(TOOLS[spec.tool].run(spec.command(), [scene], whole_image=True)[0], k, case.space)
+    assert np.abs(own_state - expected)[blocks].max() > 2 / 255
+    # The JPEG twin's O has its own histogram, and so its own reference.
+    assert twin.quality is not None and twin.reference is not case.reference

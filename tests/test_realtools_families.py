@@ -146,8 +146,11 @@ def test_pillow_filters_give_what_pillow_gives():
     tool = require_tool("pillow")
     image = _photo_tile()
     pixels = np.rint(image * 255).astype(np.uint8)
+    luma, blue, red = Image.fromarray(pixels).convert("YCbCr").split()
+    ycbcr_equalized = Image.merge("YCbCr", (ImageOps.equalize(luma), blue, red)).convert("RGB")
     for name, expected in (("pil-posterize", ImageOps.posterize(Image.fromarray(pixels), 2)),
-                           ("pil-solarize", ImageOps.solarize(Image.fromarray(pixels), 160))):
+                           ("pil-solarize", ImageOps.solarize(Image.fromarray(pixels), 160)),
+                           ("pil-ycbcr-equalize", ycbcr_equalized)):
         result = tool.run(realtools.TOOL_FILTERS[name].command(), [image])[0]
         np.testing.assert_array_equal(np.rint(result * 255).astype(np.uint8), np.asarray(expected), err_msg=name)
 

@@ -87,6 +87,12 @@ def _pil_equalize(pil, image, p):
     return pil.ImageOps.equalize(image)
 
 
+def _pil_ycbcr_equalize(pil, image, p):
+    # Pillow's recipe for colour images: equalize the luma of JPEG's YCbCr, keep the chroma.
+    luma, blue, red = image.convert("YCbCr").split()
+    return pil.Image.merge("YCbCr", (pil.ImageOps.equalize(luma), blue, red)).convert("RGB")
+
+
 def _pil_autocontrast(pil, image, p):
     return pil.ImageOps.autocontrast(image, cutoff=p["cutoff"])
 
@@ -111,7 +117,7 @@ def _run_pillow(operation, pixels, parameters):
     import types
 
     from PIL import Image, ImageFilter, ImageOps
-    pil = types.SimpleNamespace(ImageFilter=ImageFilter, ImageOps=ImageOps)
+    pil = types.SimpleNamespace(Image=Image, ImageFilter=ImageFilter, ImageOps=ImageOps)
     return np.asarray(operation(pil, Image.fromarray(pixels), parameters).convert("RGB"))
 
 
@@ -182,5 +188,5 @@ OPENCV = PythonTool("opencv", "OpenCV", "cv2", "opencv-python-headless",
                      "turbo": _cv_turbo}, _run_opencv)
 PILLOW = PythonTool("pillow", "Pillow (ImageOps, ImageFilter)", "PIL", "Pillow",
                     {"posterize": _pil_posterize, "solarize": _pil_solarize, "equalize": _pil_equalize,
-                     "autocontrast": _pil_autocontrast, "unsharp": _pil_unsharp,
+                     "ycbcr-equalize": _pil_ycbcr_equalize, "autocontrast": _pil_autocontrast, "unsharp": _pil_unsharp,
                      "gradient-map": _pil_gradient_map}, _run_pillow)
