@@ -57,8 +57,7 @@ def test_a_light_grain_is_measured_and_a_coarse_one_is_called_coarse():
 
 def _equalize_table(scene):
     """Per-channel histogram equalization of the scene's 8-bit values (as Pillow's equalize),
-    one table for O and the scene alike, as the real-tools suite computes a whole-image tool's
-    state on the scene."""
+    one table for O and the scene alike, so that F and the reference share it."""
     levels = np.rint(scene * 255).astype(np.int64)
     tables = []
     for channel in range(3):
@@ -119,3 +118,21 @@ def recover_no_worse_than_f(case):
     band = edge_band(case.original, case.filtered, case.reference)
     assert psnr(recovered, case.reference, band) >= psnr(case.filtered, case.reference, band) - 0.1, plan.reason
     return plan
+
+
+@pytest.mark.parametrize("filter_name, grained", [("pil-ycbcr-equalize", True), ("cv-gamma", False)])
+def test_a_light_grain_that_the_filter_makes_coarse_is_repaired_as_a_coarse_one(filter_name, grained):
+    """The light-grained memo (3.7 levels) under Pillow's YCbCr equalization: F's span at O's
+    quiet pixels is 61-62 levels, and at full strength R lost 0.7-1.9 dB against F; read as a
+    coarse grain (calibrated, the grain's sigma_e), it gains. Under a gamma curve (6 levels
+    there) it keeps full strength."""
+    from aarecovery.lab import realtools
+    from aarecovery.plan.paper_grain import FILTERED_GRAIN_SPAN
+    suite = realtools.RealToolsSuite("grain", ("memo",), (filter_name,), 96, {"memo": ("srgb",)})
+    (case,) = realtools.build_cases(suite, "tune", jpeg=False)
+    grain = paper_grain(case.original, case.filtered)
+    assert 0 < grain.span < COARSE_GRAIN_SPAN
+    assert (grain.filtered_span > FILTERED_GRAIN_SPAN) == grained == grain.coarse
+    plan = recover_no_worse_than_f(case)
+    expected = Decision.POINTWISE_HARD_EDGED_GRAINED if grained else Decision.POINTWISE_HARD_EDGED
+    assert plan.decision == expected, plan.reason

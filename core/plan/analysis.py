@@ -226,7 +226,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # extended by a power law: 0.774 / 0.734.
         # Neither compression noise nor a scanned page's paper grain (plan/paper_grain.py) is a
         # thin feature: pure colours only between extremes farther apart than both.
-        grain = paper_grain(o)
+        grain = paper_grain(o, f)
         prior = pure_colour_prior(o, transfer, space, f, edges,
                                   noise_contrast=max(compression.contrast, grain.contrast),
                                   extend_ends=not compression.compressed)

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..colour import LUMA
 
-__all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN", "GRAIN_EDGE_SCALE",
+__all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN", "FILTERED_GRAIN_SPAN", "GRAIN_EDGE_SCALE",
            "MAX_GRAIN_SPAN", "GRAINED_NEIGHBOURHOOD_STRENGTH"]
 
 #: The pure colours' contrast floor, in multiples of the quiet pixels' 3 x 3 luma span.
@@ -41,6 +41,12 @@ __all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN"
 GRAIN_SPAN_FACTOR = 8.0
 #: A quiet span above this (encoded) is a coarse grain: memo 3.7 levels, notice 8.9.
 COARSE_GRAIN_SPAN = 6.0 / 255
+#: F's span at O's quiet pixels above this is a coarse grain too: the filter made it one.
+#: Tuning half, memo (light grain, 3.7 levels) PNG, the median of F's 3 x 3 luma span at
+#: O's quiet pixels: 0-21 levels under every point-wise filter that its full-strength repair
+#: gains on (G'MIC's equalize 20-21, gain 0.66-0.72), 61-62 under Pillow's YCbCr equalization
+#: (lost 0.72-1.85 dB at full strength).
+FILTERED_GRAIN_SPAN = 36.0 / 255
 #: ``sigma_e`` is multiplied by this on a coarse grain.
 GRAIN_EDGE_SCALE = 10.0
 #: The strength under a smoothing filter on a coarse grain (at the grain's ``sigma_e``, no
@@ -61,9 +67,11 @@ _QUIET_PERCENTILE = 5.0
 
 @dataclass(frozen=True)
 class PaperGrain:
-    """O's quietest 3 x 3 luma span (encoded): 0 where O has flat areas, or none that is grain."""
+    """O's quietest 3 x 3 luma span (encoded): 0 where O has flat areas, or none that is grain;
+    and F's span at those quiet pixels (their median; 0 when F was not given)."""
 
     span: float
+    filtered_span: float = 0.0
 
     @property
     def contrast(self):
@@ -72,8 +80,9 @@ class PaperGrain:
 
     @property
     def coarse(self):
-        """bool: the grain goes through the filter like compression noise."""
-        return self.span > COARSE_GRAIN_SPAN
+        """bool: the grain goes through the filter like compression noise (or the filter made
+        it coarse)."""
+        return self.span > COARSE_GRAIN_SPAN or (self.span > 0 and self.filtered_span > FILTERED_GRAIN_SPAN)
 
     @property
     def edge_scale(self):
@@ -85,22 +94,31 @@ class PaperGrain:
         return f"paper grain ({self.span * 255:.1f} levels)"
 
 
-def paper_grain(encoded):
-    """Measure O's paper grain from its quietest pixels.
+def _luma_span(encoded):
+    luma = encoded @ np.asarray(LUMA, np.float32)
+    height, width = luma.shape
+    padded = np.pad(luma, 1, mode="edge")
+    shifted = [padded[dy:dy + height, dx:dx + width] for dy in range(3) for dx in range(3)]
+    return np.max(shifted, axis=0) - np.min(shifted, axis=0)
+
+
+def paper_grain(encoded, filtered=None):
+    """Measure O's paper grain from its quietest pixels, and what a point-wise filter made of it.
 
     Parameters
     ----------
     encoded : ndarray of float32, shape (H, W, 3)
         O's encoded colour (the analysis crop).
+    filtered : ndarray of float32, shape (H, W, 3), optional
+        F's encoded colour, for :attr:`PaperGrain.filtered_span`.
 
     Returns
     -------
     PaperGrain
     """
-    luma = encoded @ np.asarray(LUMA, np.float32)
-    height, width = luma.shape
-    padded = np.pad(luma, 1, mode="edge")
-    shifted = [padded[dy:dy + height, dx:dx + width] for dy in range(3) for dx in range(3)]
-    span = np.max(shifted, axis=0) - np.min(shifted, axis=0)
+    span = _luma_span(encoded)
     quiet = float(np.percentile(span, _QUIET_PERCENTILE))
-    return PaperGrain(quiet if quiet <= MAX_GRAIN_SPAN else 0.0)
+    if quiet > MAX_GRAIN_SPAN:
+        return PaperGrain(0.0)
+    filtered_span = 0.0 if filtered is None else float(np.median(_luma_span(filtered)[span <= quiet]))
+    return PaperGrain(quiet, filtered_span)
