@@ -20,8 +20,9 @@ squares dense with extrema, O is hatched, and it is used twice:
   no flat pixels, as the hatched and dotted regions have none. A sharpening filter keeps
   the strokes and is repaired at full strength everywhere.
 * A comic's screentone leaves few quiet pixels without dots, so that the texture test
-  (``texture``) reads it as a photo's grain and a neighbourhood filter kept F there. A
-  hatched O with flat paper (:func:`is_screentone_drawing`) is a drawing instead: photos
+  (``texture``) reads it as a photo's grain: a neighbourhood filter kept F there, and a
+  point-wise one got the calibrated strength of a photo. A hatched O with flat paper
+  (:func:`is_screentone_drawing`) is a drawing instead, under both kinds of filter: photos
   have almost no flat pixels and are hatched on few edges.
 
 Tuning half, drawings 96 pixels wide (the 11 x 11 square, extrema 16/255 apart): the shares
