@@ -1,13 +1,15 @@
-"""Gradient maps of a colour image's Rec. 601 grey (OpenCV, Pillow) are point-wise filters."""
+"""Gradient maps of a colour image's Rec. 601 grey (OpenCV, Pillow) and curves of its YCbCr luma
+with the chroma kept (their histogram equalization of a colour image) are point-wise filters."""
 
 from importlib import resources
 
 import numpy as np
+import pytest
 from PIL import Image, ImageOps
 
 import aarecovery
 from aarecovery.plan.calibration import EDGE_GRADIENT
-from aarecovery.plan.pointwise import POINTWISE_SHARE, fit_pointwise, key_of
+from aarecovery.plan.pointwise import POINTWISE_SHARE, SHIFT_KEYS, fit_pointwise, key_of
 from aarecovery.plan.resample import box_downsample
 from aarecovery.spec.sobel import gradient_magnitude
 
@@ -54,3 +56,39 @@ def test_pillow_colorize_of_a_photo_is_repaired_not_kept():
     plan = engine.plan()
     assert plan.decision == aarecovery.Decision.POINTWISE_CALIBRATED, plan.reason
     assert plan.strength > 0
+
+
+def _pillow_ycbcr_equalize(rgb):
+    luma, blue, red = Image.fromarray(rgb).convert("YCbCr").split()
+    return np.asarray(Image.merge("YCbCr", (ImageOps.equalize(luma), blue, red)).convert("RGB"))
+
+
+def _opencv_ycrcb_equalize(rgb):
+    cv2 = pytest.importorskip("cv2", reason="opencv-python-headless (extra 'test') runs OpenCV's equalization")
+    ycrcb = cv2.cvtColor(rgb, cv2.COLOR_RGB2YCrCb)
+    ycrcb[..., 0] = cv2.equalizeHist(np.ascontiguousarray(ycrcb[..., 0]))
+    return cv2.cvtColor(ycrcb, cv2.COLOR_YCrCb2RGB)
+
+
+@pytest.mark.parametrize("tool, key", [(_pillow_ycbcr_equalize, "luma601_floor_shift"),
+                                       (_opencv_ycrcb_equalize, "luma601_shift")])
+def test_an_equalized_ycbcr_luma_is_a_luma_shift(tool, key):
+    """F = clip(O + s(Y)): Pillow truncates its YCbCr luma, OpenCV rounds it; each is fitted by its
+    own key, and no per-channel or luma table explains the steep curve as well."""
+    original = photo()
+    o, f = original.astype(np.float32) / 255, tool(original).astype(np.float32) / 255
+    transfer = fit_pointwise(o, f, gradient_magnitude(o) >= EDGE_GRADIENT)
+    assert transfer.key == key and transfer.consistency >= POINTWISE_SHARE, (transfer.key, transfer.consistency)
+    assert all(t.consistency < POINTWISE_SHARE for t in transfer.alternatives if t.key not in SHIFT_KEYS)
+    miss = np.abs(transfer(o) - f).max(axis=-1)
+    assert np.mean(miss <= 3 / 255) >= POINTWISE_SHARE
+
+
+def test_a_photo_under_an_equalized_ycbcr_luma_is_repaired_not_kept():
+    # It was a neighbourhood filter on a textured image to every other key: F kept.
+    original = photo()
+    engine = aarecovery.Engine("numpy")
+    engine.set_images(original, _pillow_ycbcr_equalize(original))
+    plan = engine.plan()
+    assert plan.decision == aarecovery.Decision.POINTWISE_CALIBRATED, plan.reason
+    assert "luma601_floor_shift" in plan.reason and plan.strength > 0

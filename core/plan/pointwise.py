@@ -12,7 +12,8 @@ import numpy as np
 from ..colour import LUMA, REC601_LUMA, largest_channel, luma, srgb_to_linear
 from ..spec.pure_colours import LUMINANCE_KEYS, SCALE_KEYS, key_values, scale_transfer
 
-__all__ = ["PointwiseTransfer", "fit_pointwise", "filled_bins", "key_of", "POINTWISE_SHARE", "TABLE_KEYS"]
+__all__ = ["PointwiseTransfer", "fit_pointwise", "filled_bins", "key_of", "POINTWISE_SHARE", "TABLE_KEYS",
+           "SHIFT_KEYS"]
 
 # Point-wise fit: bins of the table, tolerance of a match and the share of edge pixels that
 # must match. Point-wise filters of the suite score >= 0.99; neighbourhood filters <= 0.8.
@@ -29,6 +30,17 @@ TABLE_KEYS = ("channel", "luma", "mean", "max") + tuple(LUMINANCE_KEYS) + ("luma
 # Rec. 601 luma (colour.REC601_LUMA): a TURBO-like gradient map of a colour photo's Rec. 601
 # grey matched 0.62 of the edge pixels by Rec. 709 luma, so the safe plan called it a
 # neighbourhood filter and kept F.
+#: Keys of a **luma shift**, ``F = clip(O + s(Y))`` with the same offset on every channel:
+#: a curve of the Y of JPEG's YCbCr with the chroma kept (equalizing the luma, the usual
+#: recipe for a colour image: OpenCV's ``equalizeHist`` on YCrCb's Y, Pillow's ``equalize`` on
+#: ``convert("YCbCr")``'s), since R, G and B are Y plus functions of the chroma. OpenCV rounds
+#: that Y, Pillow's YCbCr truncates it (Pillow's ``convert("L")`` rounds): a bin straddling
+#: the two gets two offsets far apart under a steep equalization curve. Tuning half, Pillow's
+#: YCbCr equalization was a neighbourhood filter to every other key (maps 0.91-0.92 of the
+#: edges matched by luma): photos kept F and the mixed scenes were repaired in their drawn
+#: regions only; keyed by the luma shift, 1.000 (maps), 0.991-1.000 (photos). No table of
+#: this key extends thin features' pure colours (``spec.pure_colours`` has no GL twin of it).
+SHIFT_KEYS = ("luma601_shift", "luma601_floor_shift")
 
 
 def key_of(colour, key):
@@ -60,10 +72,11 @@ class PointwiseTransfer:
     Attributes
     ----------
     key : str
-        What the table is indexed by (:data:`TABLE_KEYS` or a scale key): each channel of O on
-        its own, or one value per pixel.
+        What the table is indexed by (:data:`TABLE_KEYS`, a scale key or a shift key): each
+        channel of O on its own, or one value per pixel.
     table : ndarray of float32, shape (256, 3)
-        Output colour per bin (for ``"channel"``, column c maps channel c).
+        Output colour per bin (for ``"channel"``, column c maps channel c; for a shift key
+        :data:`SHIFT_KEYS`, the offset added to O's channels before clipping).
     consistency : float
         Share of O's edge pixels where ``f(O)`` matches F within 3/255.
     """
@@ -76,6 +89,9 @@ class PointwiseTransfer:
         if self.key in SCALE_KEYS:
             planes = np.ascontiguousarray(colour.reshape(-1, 3).T, dtype=np.float32)
             return scale_transfer(planes, self.key, self.table).T.reshape(colour.shape)
+        if self.key in SHIFT_KEYS:
+            index = _bins(_grey601(colour, self.key))
+            return np.clip(colour + self.table[index], 0, 1)
         values = key_of(colour, self.key)
         index = _bins(values)
         if self.key == "channel":
@@ -131,6 +147,12 @@ def fit_pointwise(original, filtered, edges):
         fitted.append(transfer)
         if best is None or _better(transfer, best):
             best = transfer
+    for key in SHIFT_KEYS:
+        transfer = PointwiseTransfer(key, _shift_table(original, filtered, key), 0.0)
+        transfer.consistency = consistency(transfer)
+        fitted.append(transfer)
+        if _better(transfer, best):
+            best = transfer
     for key in SCALE_KEYS:
         chosen = None
         for table in _scale_tables(original, filtered, key):
@@ -143,6 +165,34 @@ def fit_pointwise(original, filtered, edges):
             best = chosen
     best.alternatives = sorted(fitted, key=lambda t: (-t.consistency, t.mean_miss))
     return best
+
+
+def _grey601(colour, key):
+    """The 8-bit Rec. 601 grey of encoded colour ``(..., 3)`` that a shift key's tool indexes its
+    curve by (rounded, or truncated for ``luma601_floor_shift``), at its bin's centre: shape (...)."""
+    grey = colour @ np.array(REC601_LUMA, np.float32) * np.float32(255)
+    # The small bias keeps an exact grey level that float32 arithmetic put just below it there.
+    grey = np.floor(grey + np.float32(1e-3)) if key == "luma601_floor_shift" else np.rint(grey)
+    return ((np.clip(grey, 0, 255) + np.float32(0.5)) / np.float32(_LUT_BINS)).astype(np.float32)
+
+
+def _shift_table(original, filtered, key):
+    """A shift key's table: per grey bin, the mean of F - O over the channels F did not clip
+    (a clipped channel's difference is not the offset: the shifts of one grey level spread
+    over 40 levels on the maps); the same offset in each column."""
+    index = _bins(_grey601(original, key)).ravel()
+    sums, counts = np.zeros(_LUT_BINS), np.zeros(_LUT_BINS)
+    for c in range(3):
+        channel = filtered[..., c].ravel()
+        inside = (channel > 0.5 / 255) & (channel < 1 - 0.5 / 255)
+        shift = channel[inside].astype(np.float64) - original[..., c].ravel()[inside]
+        sums += np.bincount(index[inside], shift, minlength=_LUT_BINS)
+        counts += np.bincount(index[inside], minlength=_LUT_BINS)
+    filled = counts > 0
+    centres = np.arange(_LUT_BINS)
+    column = (np.interp(centres, centres[filled], sums[filled] / counts[filled]) if filled.any()
+              else np.zeros(_LUT_BINS))
+    return np.repeat(column[:, None], 3, axis=1).astype(np.float32)
 
 
 def _better(transfer, other):
