@@ -57,10 +57,12 @@ class NumpyBackend:
 
     def run(self, plan, maps):
         factor = None if plan.local is None else plan.local.factor(self._encoded)
-        # Pure colours that act on drawn content only are gated by the regions' weight.
+        # Pure colours that act on drawn content only are gated by the regions' weight (and
+        # the drawn ink, with an ink gate).
         gate = None
-        if factor is not None and plan.pure_colours is not None and plan.pure_colours.drawn_only:
-            gate = plan.local.region_weight(self._encoded)
+        prior = plan.pure_colours
+        if factor is not None and prior is not None and prior.drawn_only:
+            gate = plan.local.gate(self._encoded, prior.ink_gate)
         recovered, model = _recover_in_strips(self._original, self._filtered, plan, factor, gate)
         self._result = from_working_space(recovered, self._filtered_rgba, filtered_work=self._filtered,
                                           **self._space)

@@ -293,8 +293,14 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # 1.78 dB against F. Held out (not used to choose): the mixed lines did not move, as
         # the banner's and the map's overlays have almost no flat region (gate open on 3 %
         # and 0 % of their pixels).
+        # On a colour image the drawn ink opens that gate too (PureColourPrior.ink_gate), where
+        # a grey photo's recurring levels would: tuning half, the mixed scenes under point-wise
+        # filters (26 PNG cases), text and graphics 0.482 -> 0.530, whole edge band 0.428 ->
+        # 0.463, photo regions 0.297 -> 0.292 (none worse than F); every mixed case's text and
+        # graphics 0.414 -> 0.446; per case -0.072 (the poster under G'MIC's pow 3) to +0.180;
+        # the grey camera photo and text page (excluded) and no other case moved by over 0.01.
         prior = drawn_only(pure_colour_prior(o, transfer, space, f, edges, noise_contrast=compression.contrast,
-                                             extend_ends=not compression.compressed), o, edges)
+                                             extend_ends=not compression.compressed), o, edges, ink=not _is_grey(o))
         thin = ", pure colours of thin features there" if prior is not None else ""
         return PairAnalysis(space, 1.0, why + " for textured regions, full strength for hard-edged ones" + thin,
                             Decision.POINTWISE_CALIBRATED, prior, local=LocalStrength(strength))
@@ -341,6 +347,10 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                     # +0.03 to +0.22), photo regions unchanged; the poster's filters keep no
                     # flat colours there. Every filter's text and graphics 0.387 -> 0.402.
                     prior, kept = flat_colour_prior(o, f, edges)
+                    # Not opened by the drawn ink: there the photo keeps F, and the extension
+                    # at ink pixels moved the screenshot's photo regions under an unsharp mask
+                    # (built-in filter: 0.017 -> 0.009 of their error; tuning half, the mixed
+                    # scenes' neighbourhood cases -0.006 to +0.011, no gain).
                     prior = drawn_only(prior, o, edges)
                     pure = f", pure colours of thin features there ({kept})" if prior is not None else ""
                     return PairAnalysis(space, strength,

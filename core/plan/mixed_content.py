@@ -34,7 +34,7 @@ import dataclasses
 
 import numpy as np
 
-from ..spec.local_plan import LocalStrength
+from ..spec.local_plan import LocalStrength, ink_weight_at
 
 __all__ = ["drawn_share", "drawn_only", "MIXED_DRAWN_SHARE", "DRAWN_REGION_SHARE"]
 
@@ -43,10 +43,10 @@ __all__ = ["drawn_share", "drawn_only", "MIXED_DRAWN_SHARE", "DRAWN_REGION_SHARE
 #: tuning half's photos (at most 0.025) and its mixed scenes (0.21 and more).
 MIXED_DRAWN_SHARE = 0.1
 
-#: The share of a textured window's edge pixels in regions the local plan reads as drawn
-#: (``LocalStrength.region_weight`` above 0) below which a prior that acts on drawn regions
-#: only is not made: it would change next to nothing and cost the prior's passes everywhere.
-#: The 4096 x 4096 bench photo's window reads 0.
+#: The share of a textured window's edge pixels where a prior that acts on drawn regions
+#: only would act (``LocalStrength.region_weight`` above 0, or the drawn ink with an ink
+#: gate) below which it is not made: it would change next to nothing and cost the prior's
+#: passes everywhere. The 4096 x 4096 bench photo's window reads 0 (with the ink too).
 DRAWN_REGION_SHARE = 0.01
 
 
@@ -68,7 +68,7 @@ def drawn_share(encoded, edges):
     return LocalStrength(0.0).hard_edged_share(encoded, edges)
 
 
-def drawn_only(prior, encoded, edges):
+def drawn_only(prior, encoded, edges, ink=False):
     """`prior` marked to act on the drawn regions only, or None where the window has almost none.
 
     Parameters
@@ -77,14 +77,20 @@ def drawn_only(prior, encoded, edges):
     encoded : ndarray of float32, shape (H, W, 3)
         O's sRGB-encoded colour (the analysis window).
     edges : ndarray of bool, shape (H, W)
+    ink : bool
+        The drawn ink opens the gate too (``PureColourPrior.ink_gate``; colour images).
 
     Returns
     -------
     PureColourPrior or None
-        With ``drawn_only=True`` where at least :data:`DRAWN_REGION_SHARE` of the edge
-        pixels lie in drawn regions.
+        With ``drawn_only=True`` (and ``ink_gate=ink``) where at least
+        :data:`DRAWN_REGION_SHARE` of the edge pixels lie where the gate is open.
     """
     if prior is None or not edges.any():
         return None
-    share = float(np.mean(LocalStrength.region_weight(encoded)[edges] > 0))
-    return dataclasses.replace(prior, drawn_only=True) if share >= DRAWN_REGION_SHARE else None
+    rows, cols = np.nonzero(edges)
+    weight = LocalStrength.region_weight(encoded)[rows, cols]
+    if ink:
+        weight = np.maximum(weight, ink_weight_at(encoded, rows, cols))
+    share = float(np.mean(weight > 0))
+    return dataclasses.replace(prior, drawn_only=True, ink_gate=bool(ink)) if share >= DRAWN_REGION_SHARE else None

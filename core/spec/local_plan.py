@@ -52,7 +52,8 @@ the overlay's pixels (an oracle) reaches 0.434 and 0.399. The rest of the 0.9 ta
 a question of strength: thin features' pure colours on the same oracle reach 0.606. So the
 pure colours act over a photo too, where this plan reads drawn content: the extension goes
 the share of the way that the regions' weight (:meth:`LocalStrength.region_weight`) says,
-none in the photo (measured in ``aarecovery.plan.analysis``).
+on a colour image the larger of it and the drawn ink (:meth:`LocalStrength.gate`), none in
+the photo (measured in ``aarecovery.plan.analysis``).
 """
 
 from dataclasses import dataclass
@@ -340,6 +341,21 @@ class LocalStrength:
             O's sRGB-encoded colour.
         """
         return hard_edged_weight(flat_share(encoded))
+
+    @staticmethod
+    def gate(encoded, ink):
+        """float32 ``(H, W)``: where the pure colours of a prior that acts on drawn content only
+        act: :meth:`region_weight`, or with `ink` (``PureColourPrior.ink_gate``) the larger of
+        it and :func:`ink_weight`.
+
+        Parameters
+        ----------
+        encoded : ndarray of float32, shape (H, W, 3)
+            O's sRGB-encoded colour.
+        ink : bool
+        """
+        weight = LocalStrength.region_weight(encoded)
+        return np.maximum(weight, ink_weight(encoded)) if ink else weight
 
     def factor_at(self, encoded, rows, cols):
         """float32 ``(K,)``: :meth:`factor` at the pixels ``(rows[k], cols[k])`` of O only,

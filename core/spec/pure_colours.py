@@ -172,6 +172,12 @@ class PureColourPrior:
         in the regions that the local plan reads as drawn, in proportion to their weight
         (``aarecovery.spec.local_plan.LocalStrength.region_weight``, the ``gate`` of
         :func:`fit_pure_colour_model`), so that the photo is not extended.
+    ink_gate : bool
+        With `drawn_only`: the drawn ink (``aarecovery.spec.local_plan.ink_weight``: a
+        stroke's colour recurring exactly nearby) opens the gate too, where it is larger than
+        the regions' weight: captions and lines drawn straight on the photo, with no flat
+        region around them. Only on colour images (``aarecovery.plan.analysis``): a grey
+        photo's levels recur as exactly as ink.
     """
 
     key: str
@@ -183,6 +189,7 @@ class PureColourPrior:
     explain_filtered: bool = True
     noise_contrast: float = 0.0
     drawn_only: bool = False
+    ink_gate: bool = False
 
     @property
     def min_contrast(self):

@@ -21,6 +21,7 @@ uniform sampler2D original_image;  // O as uploaded (passes 1 and 3)
 uniform sampler2D local_input;     // the previous pass's output (passes 2 and 3)
 uniform float textured;            // the factor in textured regions (pass 3)
 uniform int drawn_ink;             // 1: drawn ink counts as hard-edged too (pass 3)
+uniform int ink_gate;              // 1: drawn ink opens the gate of pure colours too (pass 3)
 
 vec3 original_encoded(ivec2 p, ivec2 size) {
     vec3 c = texelFetch(original_image, clamp(p, ivec2(0), size - 1), 0).rgb;
@@ -81,8 +82,9 @@ float ink_weight(ivec2 p, ivec2 size) {
     return weight;
 }
 
-// Passes 1 and 2: their value in .x; pass 3: the factor and the regions' weight alone (the
-// gate of pure colours on drawn content only, LocalStrength.region_weight).
+// Passes 1 and 2: their value in .x; pass 3: the factor and the gate of pure colours on drawn
+// content only (LocalStrength.gate: the regions' weight, with ink_gate the larger of it and
+// the drawn ink).
 vec2 local_plan(ivec2 p, ivec2 size) {
 #if LOCAL_PASS == 1
     // Flat: the 3 x 3 neighbourhood (borders replicated) spans at most FLAT_SPAN in every
@@ -119,8 +121,10 @@ vec2 local_plan(ivec2 p, ivec2 size) {
     float inside = float((high.x - low.x + 1) * (high.y - low.y + 1));
     float t = clamp((count / inside - TEXTURED_SHARE) / (HARD_EDGED_SHARE - TEXTURED_SHARE), 0.0, 1.0);
     float region = t * t * (3.0 - 2.0 * t);
-    float weight = region;
-    if (drawn_ink != 0 && weight < 1.0) weight = max(weight, ink_weight(p, size));  // the ink is at most 1
-    return vec2(textured + (1.0 - textured) * weight, region);
+    // The ink is at most 1: at a full region weight it changes neither value.
+    float ink = (drawn_ink != 0 || ink_gate != 0) && region < 1.0 ? ink_weight(p, size) : 0.0;
+    float weight = drawn_ink != 0 ? max(region, ink) : region;
+    float gate = ink_gate != 0 ? max(region, ink) : region;
+    return vec2(textured + (1.0 - textured) * weight, gate);
 #endif
 }
