@@ -262,3 +262,21 @@ def test_a_grey_image_keeps_the_regions_gate(poster_scene):
         engine.set_images(case.original, case.filtered)
         prior = engine.plan().pure_colours
     assert prior is not None and prior.drawn_only and not prior.ink_gate
+
+
+@pytest.mark.filterwarnings("ignore::aarecovery.errors.TileSizeWarning")
+def test_the_ink_gate_is_the_same_tiled_and_untiled(poster_scene, gl_path):
+    """The gate reads O as far as the drawn ink does, within the local plan's reach: tiles give
+    the whole image's result on both backends."""
+    scene, _ = poster_scene
+    case = make_case(scene, "posterize", 4, "linear")
+    pair = tuple(np.rint(image * 255).astype(np.uint8) for image in (case.original, case.filtered))
+    whole = aarecovery.recover(*pair, backend="numpy")
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(*pair)
+        assert engine.plan().pure_colours.ink_gate
+    np.testing.assert_array_equal(aarecovery.recover(*pair, backend="numpy", tile_size=48), whole)
+    with aarecovery.Engine("gl", gl_path=gl_path) as engine:
+        for tile in (None, 48):
+            parity.assert_results_agree(aarecovery.recover(*pair, engine=engine, tile_size=tile), whole,
+                                        f"{gl_path} tile {tile}")
