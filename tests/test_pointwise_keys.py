@@ -9,7 +9,8 @@ from PIL import Image, ImageOps
 
 import aarecovery
 from aarecovery.plan.calibration import EDGE_GRADIENT
-from aarecovery.plan.pointwise import POINTWISE_SHARE, SHIFT_KEYS, fit_pointwise, key_of
+from aarecovery.plan.pointwise import POINTWISE_SHARE, fit_pointwise, key_of
+from aarecovery.spec.pure_colours import SHIFT_KEYS
 from aarecovery.plan.resample import box_downsample
 from aarecovery.spec.sobel import gradient_magnitude
 
@@ -92,3 +93,50 @@ def test_a_photo_under_an_equalized_ycbcr_luma_is_repaired_not_kept():
     plan = engine.plan()
     assert plan.decision == aarecovery.Decision.POINTWISE_CALIBRATED, plan.reason
     assert "luma601_floor_shift" in plan.reason and plan.strength > 0
+
+
+def _drawing_pair(tool):
+    """The real-tools suite's serif page in sRGB (hard-edged, coloured inks), 8-bit, and `tool`
+    of it."""
+    from aarecovery.lab.drawings import SERIF_FONT  # noqa: F401  (the scene needs the font)
+    from aarecovery.lab.realtools import FAMILIES, render_scene
+    scene, _ = render_scene("serif", 64)
+    original = np.rint(np.clip(box_downsample(scene, FAMILIES["serif"].k, "srgb"), 0, 1) * 255).astype(np.uint8)
+    return original, tool(original)
+
+
+@pytest.mark.parametrize("tool, key", [(_pillow_ycbcr_equalize, "luma601_floor_shift"),
+                                       (_opencv_ycrcb_equalize, "luma601_shift")])
+def test_thin_features_under_a_luma_shift_get_pure_colours_on_every_backend(tool, key, gl_path):
+    """A drawing under an equalized YCbCr luma: the shift key's table extends thin features to
+    their pure colours (tuning half, Pillow's: maps 0.31-0.32 -> 0.61-0.64, serif 0.76 ->
+    0.98), and the GL passes (TABLE_KEY 6 and 7) give the NumPy specification's result."""
+    from parity import assert_results_agree
+    original, filtered = _drawing_pair(tool)
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(original, filtered)
+        plan = engine.plan()
+        assert plan.decision == aarecovery.Decision.POINTWISE_HARD_EDGED, plan.reason
+        assert plan.pure_colours is not None and plan.pure_colours.key == key, plan.reason
+        engine.run(plan)
+        expected = engine.result()
+    assert np.abs(expected.astype(int) - filtered).max() > 0
+    with aarecovery.Engine("gl", gl_path=gl_path) as engine:
+        engine.set_images(original, filtered)
+        engine.run(plan)
+        assert_results_agree(engine.result(), expected, f"{gl_path} {key}")
+
+
+def test_a_shift_table_maps_8_bit_colours_as_its_transfer():
+    """The specification's f (spec.pure_colours.filtered_colour, what the passes read) is the
+    fitted transfer on O's own colours: the same grey level, the same offset."""
+    from aarecovery.plan.pure_colours import pure_colour_prior
+    from aarecovery.spec.pure_colours import filtered_colour
+    original, filtered = _drawing_pair(_pillow_ycbcr_equalize)
+    o, f = original.astype(np.float32) / 255, filtered.astype(np.float32) / 255
+    edges = gradient_magnitude(o) >= EDGE_GRADIENT
+    transfer = fit_pointwise(o, f, edges)
+    prior = pure_colour_prior(o, transfer, "srgb", f, edges)
+    colours = o.reshape(-1, 3).T
+    planes = np.concatenate([colours, np.ones((1, colours.shape[1]), np.float32)])
+    np.testing.assert_allclose(filtered_colour(planes, prior, "srgb")[:3].T, transfer(o).reshape(-1, 3), atol=1e-6)

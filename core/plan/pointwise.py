@@ -10,10 +10,9 @@ restore thin features' pure colours (``plan.pure_colours``) or calibrate the str
 import numpy as np
 
 from ..colour import LUMA, REC601_LUMA, largest_channel, luma, srgb_to_linear
-from ..spec.pure_colours import LUMINANCE_KEYS, SCALE_KEYS, key_values, scale_transfer
+from ..spec.pure_colours import LUMINANCE_KEYS, SCALE_KEYS, SHIFT_KEYS, key_values, scale_transfer, shift_grey
 
-__all__ = ["PointwiseTransfer", "fit_pointwise", "filled_bins", "key_of", "POINTWISE_SHARE", "TABLE_KEYS",
-           "SHIFT_KEYS"]
+__all__ = ["PointwiseTransfer", "fit_pointwise", "filled_bins", "key_of", "POINTWISE_SHARE", "TABLE_KEYS"]
 
 # Point-wise fit: bins of the table, tolerance of a match and the share of edge pixels that
 # must match. Point-wise filters of the suite score >= 0.99; neighbourhood filters <= 0.8.
@@ -30,17 +29,15 @@ TABLE_KEYS = ("channel", "luma", "mean", "max") + tuple(LUMINANCE_KEYS) + ("luma
 # Rec. 601 luma (colour.REC601_LUMA): a TURBO-like gradient map of a colour photo's Rec. 601
 # grey matched 0.62 of the edge pixels by Rec. 709 luma, so the safe plan called it a
 # neighbourhood filter and kept F.
-#: Keys of a **luma shift**, ``F = clip(O + s(Y))`` with the same offset on every channel:
-#: a curve of the Y of JPEG's YCbCr with the chroma kept (equalizing the luma, the usual
-#: recipe for a colour image: OpenCV's ``equalizeHist`` on YCrCb's Y, Pillow's ``equalize`` on
-#: ``convert("YCbCr")``'s), since R, G and B are Y plus functions of the chroma. OpenCV rounds
-#: that Y, Pillow's YCbCr truncates it (Pillow's ``convert("L")`` rounds): a bin straddling
-#: the two gets two offsets far apart under a steep equalization curve. Tuning half, Pillow's
-#: YCbCr equalization was a neighbourhood filter to every other key (maps 0.91-0.92 of the
-#: edges matched by luma): photos kept F and the mixed scenes were repaired in their drawn
-#: regions only; keyed by the luma shift, 1.000 (maps), 0.991-1.000 (photos). No table of
-#: this key extends thin features' pure colours (``spec.pure_colours`` has no GL twin of it).
-SHIFT_KEYS = ("luma601_shift", "luma601_floor_shift")
+# Luma shifts (spec.pure_colours.SHIFT_KEYS), F = clip(O + s(Y)) with the same offset on
+# every channel: a curve of the Y of JPEG's YCbCr with the chroma kept (equalizing the luma,
+# the usual recipe for a colour image: OpenCV's equalizeHist on YCrCb's Y, Pillow's equalize
+# on convert("YCbCr")'s), since R, G and B are Y plus functions of the chroma. OpenCV rounds
+# that Y, Pillow's YCbCr truncates it (Pillow's convert("L") rounds): a bin straddling the two
+# gets two offsets far apart under a steep equalization curve. Tuning half, Pillow's YCbCr
+# equalization was a neighbourhood filter to every other key (maps 0.91-0.92 of the edges
+# matched by luma): photos kept F and the mixed scenes were repaired in their drawn regions
+# only; keyed by the luma shift, 1.000 (maps), 0.991-1.000 (photos).
 
 
 def key_of(colour, key):
@@ -76,7 +73,7 @@ class PointwiseTransfer:
         channel of O on its own, or one value per pixel.
     table : ndarray of float32, shape (256, 3)
         Output colour per bin (for ``"channel"``, column c maps channel c; for a shift key
-        :data:`SHIFT_KEYS`, the offset added to O's channels before clipping).
+        ``spec.pure_colours.SHIFT_KEYS``, the offset added to O's channels before clipping).
     consistency : float
         Share of O's edge pixels where ``f(O)`` matches F within 3/255.
     """
@@ -169,28 +166,40 @@ def fit_pointwise(original, filtered, edges):
 
 def _grey601(colour, key):
     """The 8-bit Rec. 601 grey of encoded colour ``(..., 3)`` that a shift key's tool indexes its
-    curve by (rounded, or truncated for ``luma601_floor_shift``), at its bin's centre: shape (...)."""
-    grey = colour @ np.array(REC601_LUMA, np.float32) * np.float32(255)
-    # The small bias keeps an exact grey level that float32 arithmetic put just below it there.
-    grey = np.floor(grey + np.float32(1e-3)) if key == "luma601_floor_shift" else np.rint(grey)
-    return ((np.clip(grey, 0, 255) + np.float32(0.5)) / np.float32(_LUT_BINS)).astype(np.float32)
+    curve by (``spec.pure_colours.shift_grey``), at its bin's centre: shape (...)."""
+    planes = np.moveaxis(colour, -1, 0)
+    return ((shift_grey(planes, key) + np.float32(0.5)) / np.float32(_LUT_BINS)).astype(np.float32)
 
 
 def _shift_table(original, filtered, key):
     """A shift key's table: per grey bin, the mean of F - O over the channels F did not clip
     (a clipped channel's difference is not the offset: the shifts of one grey level spread
-    over 40 levels on the maps); the same offset in each column."""
+    over 40 levels on the maps); where F clipped every channel of a bin, the offset that
+    clips them just (white paper that stays white: 0, not its neighbours' offset); the same
+    offset in each column."""
     index = _bins(_grey601(original, key)).ravel()
     sums, counts = np.zeros(_LUT_BINS), np.zeros(_LUT_BINS)
+    above = np.full(_LUT_BINS, -np.inf)  # the least offset that clips every high channel
+    below = np.full(_LUT_BINS, np.inf)   # the greatest that clips every low one
     for c in range(3):
         channel = filtered[..., c].ravel()
-        inside = (channel > 0.5 / 255) & (channel < 1 - 0.5 / 255)
-        shift = channel[inside].astype(np.float64) - original[..., c].ravel()[inside]
+        source = original[..., c].ravel().astype(np.float64)
+        high, low = channel >= 1 - 0.5 / 255, channel <= 0.5 / 255
+        inside = ~(high | low)
+        shift = channel[inside].astype(np.float64) - source[inside]
         sums += np.bincount(index[inside], shift, minlength=_LUT_BINS)
         counts += np.bincount(index[inside], minlength=_LUT_BINS)
-    filled = counts > 0
+        np.maximum.at(above, index[high], 1 - source[high])
+        np.minimum.at(below, index[low], -source[low])
+    offsets = np.full(_LUT_BINS, np.nan)
+    measured = counts > 0
+    offsets[measured] = sums[measured] / counts[measured]
+    only_high = ~measured & np.isfinite(above) & ~np.isfinite(below)
+    only_low = ~measured & np.isfinite(below) & ~np.isfinite(above)
+    offsets[only_high], offsets[only_low] = above[only_high], below[only_low]
+    filled = np.isfinite(offsets)
     centres = np.arange(_LUT_BINS)
-    column = (np.interp(centres, centres[filled], sums[filled] / counts[filled]) if filled.any()
+    column = (np.interp(centres, centres[filled], offsets[filled]) if filled.any()
               else np.zeros(_LUT_BINS))
     return np.repeat(column[:, None], 3, axis=1).astype(np.float32)
 

@@ -13,7 +13,7 @@ import numpy as np
 from ..colour import largest_channel
 from ..params import SIGMA_D, SIGMA_E
 from ..spec import to_working_space
-from ..spec.pure_colours import (EXTENSION_KEYS, PALETTE_SIZE, PureColourPrior, filtered_colour,
+from ..spec.pure_colours import (EXTENSION_KEYS, PALETTE_SIZE, SHIFT_KEYS, PureColourPrior, filtered_colour,
                                  fit_pure_colour_model)
 from .pointwise import POINTWISE_SHARE, TABLE_KEYS, filled_bins, key_of
 
@@ -219,7 +219,17 @@ def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None
     palette = palette_of(original)
     fit = [candidate for candidate in transfer.alternatives
            if candidate.consistency >= POINTWISE_SHARE and candidate.key in EXTENSION_KEYS
-           and is_monotone(candidate.table)]
+           and is_monotone(_mapped_table(candidate))]
+    # A luma shift only where no other key explains F (an equalized YCbCr luma): on a grey
+    # image it ties with the channel table, and as a tied candidate that disagrees on the
+    # cube it took the extension's reach to the cube away (tuning half, the manga under
+    # G'MIC's equalize at q 75: 0.751 -> 0.671).
+    # Nor above compression noise or a paper grain: a grain-level change of the grey moves a
+    # steep curve's offset by whole steps, and the extension painted the grain into the paper
+    # (tuning half, the memo and notice pages under Pillow's YCbCr equalization: 2-30 -> 17-214
+    # paper pixels darker than F per case, for 0.17-0.41 -> 0.30-0.60 of their edge error).
+    others = [candidate for candidate in fit if candidate.key not in SHIFT_KEYS]
+    fit = others or ([] if noise_contrast > 0 else fit)
     if not fit:
         return None
     priors = [PureColourPrior(candidate.key, palette=palette, noise_contrast=float(noise_contrast),
@@ -239,6 +249,15 @@ def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None
     return chosen
 
 
+def _mapped_table(candidate):
+    """What a candidate's table maps its key to: the table, or for a shift key (``F = clip(O +
+    s(Y))``) each grey level plus its offset, the luma it maps to, which is monotone where
+    the filter is (an equalization), while the offset alone is not."""
+    if candidate.key not in SHIFT_KEYS:
+        return candidate.table
+    return (candidate.table + (np.arange(256, dtype=np.float32) / np.float32(255))[:, None]).astype(np.float32)
+
+
 def _extrapolated(original, candidate, extend_ends):
     # A JPEG's key range ends at its ringing and its end bins hold few, noisy pixels: the power
     # law through them is no guide to the ink beyond, so the table stays flat there
@@ -249,8 +268,11 @@ def _extrapolated(original, candidate, extend_ends):
     # most 0.02 in error reduction. A coarse paper grain (plan/paper_grain.py) keeps the
     # extrapolation: flat there, the grained page lost 0.04-0.07 under GEGL's levels and
     # exposure.
+    # A shift key's table is not extrapolated: an offset's power law is no curve's, and the
+    # curves it fits (equalizations) reach black and white within O's range.
     table, low, high = extrapolate_table(candidate.table, filled_bins(original, candidate.key))
-    return {"table": table if extend_ends else candidate.table, "key_low": low, "key_high": high}
+    extend = extend_ends and candidate.key not in SHIFT_KEYS
+    return {"table": table if extend else candidate.table, "key_low": low, "key_high": high}
 
 
 # Tables that explain F within this mean miss of the best one tie with it.

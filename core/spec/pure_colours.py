@@ -60,13 +60,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..colour import LUMA_WEIGHTS, LUMINANCE_D50, linear_to_srgb, srgb_to_linear
+from ..colour import LUMA_WEIGHTS, LUMINANCE_D50, REC601_LUMA, linear_to_srgb, srgb_to_linear
 from .blend_model import BlendModel, confidence, coverage, fit_extremes
 from .neighbourhood import NEIGHBOUR_OFFSETS, dot, neighbours, planes
 from .sobel import sobel_magnitude
 
-__all__ = ["PureColourPrior", "PALETTE_SIZE", "ON_LINE_TOLERANCE", "KEPT_CONTRAST", "EXTENSION_KEYS", "SCALE_KEYS", "filtered_colour", "extend_extreme",
-           "scale_transfer", "key_values", "fit_pure_colour_model"]
+__all__ = ["PureColourPrior", "PALETTE_SIZE", "ON_LINE_TOLERANCE", "KEPT_CONTRAST", "EXTENSION_KEYS", "SCALE_KEYS",
+           "SHIFT_KEYS", "filtered_colour", "extend_extreme", "scale_transfer", "key_values", "shift_grey",
+           "fit_pure_colour_model"]
 
 #: Most palette colours kept (a uniform array in the GL pass).
 PALETTE_SIZE = 32
@@ -114,9 +115,23 @@ KEPT_CONTRAST = 0.5
 #: 8 keeps 8-bit inputs away from the threshold. Measured: no change of any case's error
 #: reduction on the quick and full suites (16.5/255 cost 0.0001 on the full suite's sRGB mean).
 MIN_CONTRAST = 8.5 / 255
+#: Keys of a **luma shift**, ``f(c) = clip(c + s(Y))``, the same offset on every channel: a
+#: curve of the 8-bit Y of JPEG's YCbCr with the chroma kept (``aarecovery.plan.pointwise``
+#: fits them), Y computed exactly as the tool does (:func:`shift_grey`): ``"luma601_shift"``
+#: as OpenCV's YCrCb, ``"luma601_floor_shift"`` as Pillow's YCbCr. Column 0 of the table holds
+#: the offset per grey level.
+SHIFT_KEYS = ("luma601_shift", "luma601_floor_shift")
 #: Table keys for which the extension is used (see the module notes).
-EXTENSION_KEYS = ("channel", "luma", "luma_scale", "luminance_scale", "luminance", "luminance_d50")
-_KEY_CODES = {"channel": 0, "luma": 1, "luma_scale": 2, "luminance_scale": 3, "luminance": 4, "luminance_d50": 5}
+EXTENSION_KEYS = ("channel", "luma", "luma_scale", "luminance_scale", "luminance", "luminance_d50") + SHIFT_KEYS
+_KEY_CODES = {"channel": 0, "luma": 1, "luma_scale": 2, "luminance_scale": 3, "luminance": 4, "luminance_d50": 5,
+              "luma601_shift": 6, "luma601_floor_shift": 7}
+# The tools' fixed-point Rec. 601 Y of 8-bit R, G, B (each matched 262,144 random colours
+# exactly): OpenCV's weights in 1/16384 with rounding; Pillow's YCbCr sums its weights times
+# 64, each rounded to a whole number, and truncates (its Y is a level below the rounded
+# luma's on half of all colours, and on 1 % below the truncated luma's). Whole numbers below
+# 2^24: exact in float32 on both backends.
+_OPENCV_Y = (4899.0, 9617.0, 1868.0, 16384.0)
+_PILLOW_Y = (19.136, 37.568, 7.296, 64.0)
 #: Keys of one value per pixel: the encoded value of the luminance of linear light, with the
 #: Rec. 709 weights or babl's D50 ones (colour to grey and thresholds by luminance).
 LUMINANCE_KEYS = {"luminance": LUMA_WEIGHTS, "luminance_d50": np.array(LUMINANCE_D50, np.float32)}
@@ -137,10 +152,12 @@ class PureColourPrior:
 
     Attributes
     ----------
-    key : {"channel", "luma", "luma_scale", "luminance_scale", "luminance", "luminance_d50"}
+    key : {"channel", "luma", "luma_scale", "luminance_scale", "luminance", "luminance_d50", "luma601_shift", "luma601_floor_shift"}
         How :attr:`table` is indexed: each channel of the encoded colour, its luma, or the
         encoded value of its luminance (:data:`LUMINANCE_KEYS`); the scale keys map luma
-        (encoded) or luminance (linear) and scale colour with it (:func:`scale_transfer`).
+        (encoded) or luminance (linear) and scale colour with it (:func:`scale_transfer`);
+        the shift keys add an offset of the 8-bit Rec. 601 grey to every channel
+        (:data:`SHIFT_KEYS`).
     table : ndarray of float32, shape (256, 3)
         Encoded output colour per bin of the key; read with linear interpolation between
         bin centres ``(i + 0.5) / 256``.
@@ -205,7 +222,7 @@ class PureColourPrior:
     @property
     def key_code(self):
         """int: the GL define ``TABLE_KEY`` (0 channel, 1 luma, 2 luma_scale, 3 luminance_scale,
-        4 luminance, 5 luminance_d50)."""
+        4 luminance, 5 luminance_d50, 6 luma601_shift, 7 luma601_floor_shift)."""
         return _KEY_CODES[self.key]
 
     def palette_in(self, blend_space):
@@ -259,9 +276,35 @@ def _encoded_of(colour, blend_space):
     return (linear_to_srgb(straight.T).T if blend_space == "linear" else straight).astype(np.float32)
 
 
+def shift_grey(encoded, key):
+    """A shift key's 8-bit Rec. 601 grey level of encoded colour planes ``(3, N)`` (or ``(3,
+    ...)``), as its tool computes it from the 8-bit channels: float32 of whole numbers in
+    [0, 255].
+
+    ``luma601_shift``: OpenCV's, ``(4899 R + 9617 G + 1868 B + 8192) >> 14``;
+    ``luma601_floor_shift``: Pillow's YCbCr, ``(round(19.136 R) + round(37.568 G) +
+    round(7.296 B)) >> 6`` (each product's fraction is a multiple of 0.008, so no rounding
+    is a tie).
+    """
+    levels = [np.floor(np.clip(encoded[c], 0, 1) * np.float32(255) + np.float32(0.5)) for c in range(3)]
+    if key == "luma601_shift":
+        r, g, b, scale = (np.float32(v) for v in _OPENCV_Y)
+        grey = np.floor((levels[0] * r + levels[1] * g + levels[2] * b + scale / 2) / scale)
+    else:
+        r, g, b, scale = (np.float32(v) for v in _PILLOW_Y)
+        half = np.float32(0.5)
+        grey = np.floor((np.floor(levels[0] * r + half) + np.floor(levels[1] * g + half)
+                         + np.floor(levels[2] * b + half)) / scale)
+    return np.clip(grey, 0, 255).astype(np.float32)
+
+
 def key_values(encoded, key):
     """The table keys of encoded colour planes ``(3, N)``: shape (3, N), one row per table
-    column (luma, luminance and the scale keys repeat one value)."""
+    column (luma, luminance, the scale and the shift keys repeat one value; a shift key's is
+    its grey level's bin centre)."""
+    if key in SHIFT_KEYS:
+        return np.broadcast_to(((shift_grey(encoded, key) + np.float32(0.5)) / np.float32(256)).astype(np.float32),
+                               encoded.shape)
     if key in LUMINANCE_KEYS:
         weights = LUMINANCE_KEYS[key]
         values = srgb_to_linear(encoded.T).T.astype(np.float32)
@@ -303,6 +346,8 @@ def filtered_colour(colour, prior, blend_space, low_end=None, high_end=None):
         keys = np.where(high_end, np.minimum(keys, high[:, None]), keys).astype(np.float32)
     if prior.key in SCALE_KEYS:
         out = scale_transfer(encoded, prior.key, prior.table, keys[0])
+    elif prior.key in SHIFT_KEYS:
+        out = np.clip(encoded + _table_at(prior.table[:, 0], keys[0]), 0, 1).astype(np.float32)
     else:
         out = np.stack([_table_at(prior.table[:, c], keys[c]) for c in range(3)]).astype(np.float32)
     decoded = srgb_to_linear(np.clip(out, 0, 1).T).T if blend_space == "linear" else out

@@ -21,6 +21,8 @@ uniform float noise_contrast;      // O's compression noise as a contrast (0: no
 //            4/5: encoded luminance (Rec. 709 / D50 weights) indexes all,
 //            2/3: luma (encoded) / luminance (linear) mapped by column 0, colour scaled
 //            with it (scale_transfer)
+//            6/7: the 8-bit Rec. 601 grey (rounded / truncated) indexes an offset added to
+//            every channel (SHIFT_KEYS, shift_grey)
 // CLAMP_ENDS: 1: an extreme at an end of the range reads the table clamped
 // TO_CUBE: 0: extend only to a flat colour of O beyond the extreme
 #ifndef TABLE_KEY
@@ -39,6 +41,7 @@ uniform float noise_contrast;      // O's compression noise as a contrast (0: no
 #define EXPLAIN_FILTERED 1
 #endif
 #define SCALE_KEY (TABLE_KEY == 2 || TABLE_KEY == 3)
+#define SHIFT_KEY (TABLE_KEY == 6 || TABLE_KEY == 7)
 
 const float PALETTE_TOLERANCE = 0.03;
 const float LINE_TOLERANCE = 0.05;
@@ -50,6 +53,9 @@ const float RANGE_TOLERANCE = 0.05;
 const float END_TOLERANCE = 1.0 / 255.0;
 const float MIN_CONTRAST = 8.5 / 255.0;
 const float MIN_REACH = 1.2001;
+// The tools' fixed-point Rec. 601 Y (spec.pure_colours._OPENCV_Y, _PILLOW_Y): weights and scale.
+const vec4 OPENCV_Y = vec4(4899.0, 9617.0, 1868.0, 16384.0);
+const vec4 PILLOW_Y = vec4(19.136, 37.568, 7.296, 64.0);
 
 float table_at(float key, int channel) {
     // Linear interpolation between bin centres, two fetches (no texture filtering: llvmpipe's
@@ -86,6 +92,19 @@ vec3 encoded_of(vec4 colour) {
 vec3 key_values(vec3 encoded) {
 #if TABLE_KEY == 0
     return encoded;
+#elif SHIFT_KEY
+    // The grey level as the tool computes it from the 8-bit channels, at its bin's centre
+    // (shift_grey): whole numbers below 2^24, exact in float.
+    vec3 levels = floor(clamp(encoded, 0.0, 1.0) * 255.0 + 0.5);
+#if TABLE_KEY == 6
+    float grey = floor((levels.r * OPENCV_Y.x + levels.g * OPENCV_Y.y + levels.b * OPENCV_Y.z + OPENCV_Y.w / 2.0)
+                       / OPENCV_Y.w);
+#else
+    float grey = floor((floor(levels.r * PILLOW_Y.x + 0.5) + floor(levels.g * PILLOW_Y.y + 0.5)
+                        + floor(levels.b * PILLOW_Y.z + 0.5)) / PILLOW_Y.w);
+#endif
+    grey = clamp(grey, 0.0, 255.0);
+    return vec3((grey + 0.5) / 256.0);
 #elif TABLE_KEY == 4 || TABLE_KEY == 5
     // The encoded value of the luminance of linear light (LUMINANCE_KEYS).
     vec3 weights = TABLE_KEY == 4 ? LUMA : LUMINANCE_D50;
@@ -108,6 +127,8 @@ vec4 filtered_colour_of(vec4 colour, vec3 encoded, vec3 keys) {
     vec3 scaled = luma > 1e-6 ? values * (mapped / luma) : vec3(mapped);
     scaled = clamp(scaled, 0.0, 1.0);
     vec3 out_colour = TABLE_KEY == 3 ? linear_to_srgb(scaled) : scaled;
+#elif SHIFT_KEY
+    vec3 out_colour = clamp(encoded + vec3(table_at(keys.r, 0)), 0.0, 1.0);
 #elif TABLE_KEY == 0
     vec3 out_colour = vec3(table_at(keys.r, 0), table_at(keys.g, 1), table_at(keys.b, 2));
 #else
