@@ -95,28 +95,29 @@ def test_a_photo_under_an_equalized_ycbcr_luma_is_repaired_not_kept():
     assert "luma601_floor_shift" in plan.reason and plan.strength > 0
 
 
-def _drawing_pair(tool):
-    """The real-tools suite's serif page in sRGB (hard-edged, coloured inks), 8-bit, and `tool`
-    of it."""
-    from aarecovery.lab.drawings import SERIF_FONT  # noqa: F401  (the scene needs the font)
+def _drawing_pair(tool, space="srgb"):
+    """The real-tools suite's serif page antialiased in `space` (hard-edged, coloured inks),
+    8-bit, and `tool` of it."""
     from aarecovery.lab.realtools import FAMILIES, render_scene
     scene, _ = render_scene("serif", 64)
-    original = np.rint(np.clip(box_downsample(scene, FAMILIES["serif"].k, "srgb"), 0, 1) * 255).astype(np.uint8)
+    original = np.rint(np.clip(box_downsample(scene, FAMILIES["serif"].k, space), 0, 1) * 255).astype(np.uint8)
     return original, tool(original)
 
 
+@pytest.mark.parametrize("space", ["srgb", "linear"])
 @pytest.mark.parametrize("tool, key", [(_pillow_ycbcr_equalize, "luma601_floor_shift"),
                                        (_opencv_ycrcb_equalize, "luma601_shift")])
-def test_thin_features_under_a_luma_shift_get_pure_colours_on_every_backend(tool, key, gl_path):
+def test_thin_features_under_a_luma_shift_get_pure_colours_on_every_backend(tool, key, space, gl_path):
     """A drawing under an equalized YCbCr luma: the shift key's table extends thin features to
     their pure colours (tuning half, Pillow's: maps 0.31-0.32 -> 0.61-0.64, serif 0.76 ->
     0.98), and the GL passes (TABLE_KEY 6 and 7) give the NumPy specification's result."""
     from parity import assert_results_agree
-    original, filtered = _drawing_pair(tool)
+    original, filtered = _drawing_pair(tool, space)
     with aarecovery.Engine("numpy") as engine:
         engine.set_images(original, filtered)
         plan = engine.plan()
         assert plan.decision == aarecovery.Decision.POINTWISE_HARD_EDGED, plan.reason
+        assert plan.blend_space == space, plan.reason
         assert plan.pure_colours is not None and plan.pure_colours.key == key, plan.reason
         engine.run(plan)
         expected = engine.result()
