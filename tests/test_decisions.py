@@ -64,6 +64,12 @@ def _grained_page_levels():
     return original, np.clip((original - 0.3) / 0.4, 0, 1).astype(np.float32)
 
 
+def _grey_photo(filter_name):
+    scene = _scenes.render("astronaut", 128, 4)
+    case = make_case(np.repeat(scene.mean(axis=-1, keepdims=True), 3, axis=-1), filter_name, 4, "linear")
+    return case.original, case.filtered
+
+
 def _quantised_photo():
     original = _photo_like(seed=2)
     return original, _quantise(original, PALETTE)
@@ -77,6 +83,7 @@ PAIRS = {
     Decision.POINTWISE_HARD_EDGED: lambda: _case("shapes", "posterize"),
     Decision.POINTWISE_CALIBRATED: lambda: _case("astronaut", "posterize"),
     Decision.NEIGHBOURHOOD_TEXTURED_KEPT: lambda: _case("astronaut", "unsharp"),
+    Decision.NEIGHBOURHOOD_GREY_SHARPENED: lambda: _grey_photo("unsharp"),
     Decision.NEIGHBOURHOOD_MIXED: lambda: (_drawing("poster"), aarecovery.filters.apply("unsharp", _drawing("poster"))),
     Decision.COLOUR_MAP_KEPT: lambda: (_drawing("maps"), _saturate(_drawing("maps"), 1.5)),
     Decision.COLOUR_MAP_CALIBRATED: _quantised_photo,
