@@ -66,7 +66,7 @@ All of it runs once, in NumPy, on a central crop, before tiling, and results in 
 from dataclasses import dataclass, replace
 
 from ..backends.base import Decision
-from ..colour import largest_channel, linear_to_srgb
+from ..colour import linear_to_srgb
 from ..contract import layout_of, to_rgba_float
 from ..params import ITERATIONS, SIGMA_D, SIGMA_E
 from ..spec.local_plan import LocalStrength
@@ -87,7 +87,7 @@ from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, paper_grain
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import pure_colour_prior
 from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, UNTOUCHED_SPAN, contrast_ratio
-from .texture import is_textured
+from .texture import is_grey, is_textured
 
 __all__ = ["PairAnalysis", "analyse", "analyse_pair", "analysis_crop"]
 
@@ -108,11 +108,6 @@ _PHOTO_NEIGHBOURHOOD_STRENGTH = 0.0
 # portrait down to 0.08); the colour photos lose at 1 (coffee -0.96 to -1.11, hubble -0.34 to
 # -1.14) and keep F; under smoothing filters the grey portrait loses too (-0.14 to -0.19).
 _GREY_SHARPENED_STRENGTH = 0.5
-# Channels within this everywhere: a grey (or faintly tinted) image, whose colour lines cannot
-# tell the antialiasing space; the manga pages' cream paper differs by 3 levels, and by 5 once
-# saved as JPEG at q 95-98 (the chroma's rounding); the next least coloured family, a scanned
-# letter, by 22.
-_NEAR_GREY = 8.0 / 255
 # The reasons' note of a smoothing filter's untouched edges (plan/smoothing.py).
 _UNTOUCHED = ", F kept where it left O's edges as they were"
 
@@ -217,7 +212,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # on 1.000 of its edges and 0.87-0.92 in linear light, lost 10.2 dB against F at the
     # calibrated strength (antialiased in sRGB) and gained 0.23 (in linear light); kept, both
     # are F.
-    affine_spaces = (space, "srgb") if space == "linear" and _is_grey(o) else (space,)
+    affine_spaces = (space, "srgb") if space == "linear" and is_grey(o) else (space,)
     for affine_space in affine_spaces:
         affine = affine_share(o, f, edges, affine_space)
         if affine >= AFFINE_SHARE:
@@ -310,7 +305,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # graphics 0.414 -> 0.446; per case -0.072 (the poster under G'MIC's pow 3) to +0.180;
         # the grey camera photo and text page (excluded) and no other case moved by over 0.01.
         prior = drawn_only(pure_colour_prior(o, transfer, space, f, edges, noise_contrast=compression.contrast,
-                                             extend_ends=not compression.compressed), o, edges, ink=not _is_grey(o))
+                                             extend_ends=not compression.compressed), o, edges, ink=not is_grey(o))
         thin = ", pure colours of thin features there" if prior is not None else ""
         return PairAnalysis(space, 1.0, why + " for textured regions, full strength for hard-edged ones" + thin,
                             Decision.POINTWISE_CALIBRATED, prior, local=LocalStrength(strength))
@@ -370,7 +365,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                         Decision.NEIGHBOURHOOD_MIXED, prior, local=LocalStrength(0.0),
                                         untouched_span=UNTOUCHED_SPAN if smoothing else 0.0)
             sharpening = contrast_ratio(o, f, edges)
-            if _is_grey(o) and sharpening >= SMOOTHED_CONTRAST:
+            if is_grey(o) and sharpening >= SMOOTHED_CONTRAST:
                 return PairAnalysis(space, _GREY_SHARPENED_STRENGTH,
                                     f"sharpening filter on a grey photo ({texture}; F's edge contrast "
                                     f"{sharpening:.2f} times O's): strength {_GREY_SHARPENED_STRENGTH:g}",
@@ -452,13 +447,6 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         return PairAnalysis(space, SMOOTHED_STRENGTH, why + f": a smoothing filter, strength {SMOOTHED_STRENGTH:g}"
                             + pure + _UNTOUCHED, Decision.NEIGHBOURHOOD_HARD_EDGED, prior, **untouched)
     return PairAnalysis(space, 1.0, why + ": full strength" + pure, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
-
-
-def _is_grey(encoded):
-    """True when every pixel's channels are equal to within :data:`_NEAR_GREY`."""
-    # Channel by channel (colour.largest_channel; the smallest as minus the largest of minus
-    # it, the same values): 15 ms -> 1 ms on a 512 x 512 window.
-    return bool((largest_channel(encoded) + largest_channel(-encoded)).max() <= _NEAR_GREY)
 
 
 def _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e):
