@@ -138,6 +138,9 @@ def is_textured(encoded, colour_line_residual, compression=None):
     # treatment is never worse than F. A grey photo 64 pixels wide (the built-in astronaut in
     # grey) read as hard-edged and lost 1.2 of its edge error under an unsharp mask at full
     # strength; no image of the suites, tuning or held out, is grey without quiet pixels.
+    # The cost, on the built-in scenes in grey at 48-64 pixels: dense lines under a threshold
+    # 0.75-0.76 -> 0.54-0.55 of their edge error, under gamma 0.24-0.25 -> 0.20-0.21, the
+    # chart 0.70 -> 0.69 and 0.50 -> 0.42; none worse than F.
     if colour_line_residual is None or colour_line_residual > STRICT_RESIDUAL or is_grey(encoded):
         return True, ("no colour to test" if colour_line_residual is None or is_grey(encoded)
                       else f"colour-line residual {colour_line_residual:.3f}")
