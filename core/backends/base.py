@@ -46,7 +46,7 @@ class Decision(str, enum.Enum):
     NEIGHBOURHOOD_TEXTURED_KEPT = "neighbourhood-textured-kept"
     """A filter that is neither point-wise nor a colour map, on a textured image: F is kept."""
     NEIGHBOURHOOD_GREY_SHARPENED = "neighbourhood-grey-sharpened"
-    """A sharpening filter (an unsharp mask) on a grey photo: a lower strength. Every grey
+    """A sharpening filter (an unsharp mask) on a grey photo: a quarter strength. Every grey
     3 x 3 neighbourhood lies on one colour line, so the model flattens no colour texture."""
     NEIGHBOURHOOD_MIXED = "neighbourhood-mixed"
     """The same on a photo with text or drawings over part of it: the drawn regions are

@@ -104,10 +104,14 @@ _PHOTO_NEIGHBOURHOOD_STRENGTH = 0.0
 # so the model flattens no colour texture there, and a lower strength repairs part of the
 # mask's damage. Tuning half, the grey photos (handwriting, portrait) under GEGL's and
 # ImageMagick's unsharp masks, PNG and JPEG (8 cases, kept F before), mean edge-band error
-# reduction by strength: 0.25 0.26, 0.5 0.32 (every case 0.16-0.57), 0.75 0.30, 1 0.21 (the
+# reduction by strength: 0.25 0.26 (every case 0.10-0.52), 0.5 0.32, 0.75 0.30, 1 0.21 (the
 # portrait down to 0.08); the colour photos lose at 1 (coffee -0.96 to -1.11, hubble -0.34 to
 # -1.14) and keep F; under smoothing filters the grey portrait loses too (-0.14 to -0.19).
-_GREY_SHARPENED_STRENGTH = 0.5
+# A grey image cannot tell its blend space (the model blends in linear light): a photo
+# downscaled in sRGB values, as most resizers do, lost at 0.5 (the built-in photos in grey
+# under the built-in unsharp mask: chelsea -1.8 to -2.1 dB, coffee -0.3) and gains at 0.25
+# (+0.5 to +1.9 dB), so the lower strength.
+_GREY_SHARPENED_STRENGTH = 0.25
 # The reasons' note of a smoothing filter's untouched edges (plan/smoothing.py).
 _UNTOUCHED = ", F kept where it left O's edges as they were"
 
