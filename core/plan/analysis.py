@@ -216,7 +216,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # on 1.000 of its edges and 0.87-0.92 in linear light, lost 10.2 dB against F at the
     # calibrated strength (antialiased in sRGB) and gained 0.23 (in linear light); kept, both
     # are F.
-    affine_spaces = (space, "srgb") if space == "linear" and is_grey(o) else (space,)
+    grey = is_grey(o)
+    affine_spaces = (space, "srgb") if space == "linear" and grey else (space,)
     for affine_space in affine_spaces:
         affine = affine_share(o, f, edges, affine_space)
         if affine >= AFFINE_SHARE:
@@ -309,7 +310,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # graphics 0.414 -> 0.446; per case -0.072 (the poster under G'MIC's pow 3) to +0.180;
         # the grey camera photo and text page (excluded) and no other case moved by over 0.01.
         prior = drawn_only(pure_colour_prior(o, transfer, space, f, edges, noise_contrast=compression.contrast,
-                                             extend_ends=not compression.compressed), o, edges, ink=not is_grey(o))
+                                             extend_ends=not compression.compressed), o, edges, ink=not grey)
         thin = ", pure colours of thin features there" if prior is not None else ""
         return PairAnalysis(space, 1.0, why + " for textured regions, full strength for hard-edged ones" + thin,
                             Decision.POINTWISE_CALIBRATED, prior, local=LocalStrength(strength))
@@ -369,7 +370,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                         Decision.NEIGHBOURHOOD_MIXED, prior, local=LocalStrength(0.0),
                                         untouched_span=UNTOUCHED_SPAN if smoothing else 0.0)
             sharpening = contrast_ratio(o, f, edges)
-            if is_grey(o) and sharpening >= SMOOTHED_CONTRAST:
+            if grey and sharpening >= SMOOTHED_CONTRAST:
                 return PairAnalysis(space, _GREY_SHARPENED_STRENGTH,
                                     f"sharpening filter on a grey photo ({texture}; F's edge contrast "
                                     f"{sharpening:.2f} times O's): strength {_GREY_SHARPENED_STRENGTH:g}",

@@ -152,8 +152,8 @@ class PureColourPrior:
 
     Attributes
     ----------
-    key : {"channel", "luma", "luma_scale", "luminance_scale", "luminance", "luminance_d50", "luma601_shift", "luma601_floor_shift"}
-        How :attr:`table` is indexed: each channel of the encoded colour, its luma, or the
+    key : str
+        One of :data:`EXTENSION_KEYS`: how :attr:`table` is indexed: each channel of the encoded colour, its luma, or the
         encoded value of its luminance (:data:`LUMINANCE_KEYS`); the scale keys map luma
         (encoded) or luminance (linear) and scale colour with it (:func:`scale_transfer`);
         the shift keys add an offset of the 8-bit Rec. 601 grey to every channel
