@@ -62,8 +62,8 @@ def test_gpu_lists_equal_numpy_lists(classifying_engine, name, image):
             assert sorted(map(tuple, found[which][list_name])) == sorted(map(tuple, expected[list_name])), \
                 (which, list_name)
     for list_name in LISTS:
-        assert dispatches[list_name] == (min(len(found["original"][list_name]), 65535),
-                                         -(-len(found["original"][list_name]) // 65535), 1)
+        length = len(found["original"][list_name])
+        assert dispatches[list_name] == (length, int(length > 0), 1)
 
 
 def test_numpy_lists_are_consistent():
@@ -87,7 +87,7 @@ def test_numpy_lists_are_consistent():
 @pytest.mark.parametrize("compute_classification", [True, False])
 def test_long_lists_dispatch_in_rows(compute_classification):
     # A list longer than a dispatch row allows (65535 groups; 7 here) runs in rows of work
-    # groups, the last one partly past the list's end.
+    # groups, spread evenly: fewer groups past the list's end than there are rows.
     from test_gl_parity import PAIRS
     engine = aarecovery.Engine(backend="gl", gl_path="compute")
     try:
@@ -97,7 +97,11 @@ def test_long_lists_dispatch_in_rows(compute_classification):
             engine.set_images(original, filtered)
             with engine.context:
                 sizes = dispatch_sizes(engine._impl, "filtered")
+                entries = gpu_lists(engine._impl, "filtered", raw=True)
             assert any(size[1] > 1 for size in sizes.values())
+            for name, (columns, rows, depth) in sizes.items():
+                length = len(entries[name])
+                assert columns <= 7 and depth == 1 and 0 <= columns * rows - length < max(rows, 1), (name, sizes)
             for mode in ("paper", "safe"):
                 actual = aarecovery.recover(original, filtered, engine=engine, mode=mode)
                 expected = aarecovery.recover(original, filtered, backend="numpy", mode=mode)

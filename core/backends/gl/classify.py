@@ -28,11 +28,18 @@ _DISPATCH_OFFSET = _DRAW_BYTES * len(LISTS)
 MAX_GROUPS = 65535
 
 
+def _dispatch_shape(length, max_groups=MAX_GROUPS):
+    """``(groups per row, rows)`` dispatching `length` blocks: the fewest rows, filled evenly
+    (``finish_block_lists.comp`` says why)."""
+    rows = max(-(-length // max_groups), 1)
+    return -(-length // rows), rows if length else 0
+
+
 def _commands(counts, blocks, max_groups=MAX_GROUPS):
     """The commands buffer of lists of these lengths holding so many blocks, as
     ``compact_blocks.comp`` and ``finish_block_lists.comp`` make it (``block_lists.glsl``)."""
     draws = [[6, counts[name], 0, 0, 0] for name in LISTS]
-    dispatches = [[min(counts[name], max_groups), -(-counts[name] // max_groups), 1] for name in LISTS]
+    dispatches = [list(_dispatch_shape(counts[name], max_groups)) + [1] for name in LISTS]
     words = [word for command in draws + dispatches + [[blocks[name] for name in LISTS]] for word in command]
     return struct.pack(f"{len(words)}I", *words)
 
