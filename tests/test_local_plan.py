@@ -250,7 +250,8 @@ def test_drawn_ink_opens_the_pure_colours_gate_on_a_colour_image(poster_scene, f
                     for region in ("text/graphics", "photo")] for name, image in results.items()}
     (text, photo), (text_before, photo_before) = score["ink"], score["regions only"]
     assert text > text_before + 0.1, score
-    assert photo == pytest.approx(photo_before, abs=0.01), score
+    # 0.005 apart here; 0.011 on a machine whose Pillow drew the poster's text a little differently.
+    assert photo == pytest.approx(photo_before, abs=0.015), score
 
 
 def test_a_grey_image_keeps_the_regions_gate(poster_scene):
