@@ -23,9 +23,10 @@ A shared-memory tile for the fit's neighbourhoods (``SHARED_TILE`` in
 ``fit_blend_model.comp``) made the fit 1.6x slower on llvmpipe (0.92 s against 0.56 s of CPU,
 2048 x 2048 under gamma: barriers are expensive there). On the H100 it changed nothing at
 3840 x 2160 (810 against 837 MP/s under gamma, the fit pass alone 1.25 against 0.71 ms) and
-helped only at 4096 x 4096 under gamma (743 against 458 MP/s), where every pass ran several
-times slower per pixel than at 3840 x 2160 for a reason not found (docs/performance.md); it
-stays off (``GLBackend.shared_tile``; ``aarecovery bench`` times both).
+helped only at 4096 x 4096 under gamma (743 against 458 MP/s), where every pass then ran
+several times slower per pixel than at 3840 x 2160 (half of its work groups were past the
+end of the block list, since fixed in ``finish_block_lists.comp``); it stays off
+(``GLBackend.shared_tile``; ``aarecovery bench`` times both).
 """
 
 import moderngl
