@@ -185,7 +185,7 @@ class GLBackend:
         self._overlap_readback = not software_renderer(self.context)
         #: Whether 8-bit RGB images are uploaded as they are into a buffer and expanded to
         #: RGBA8 by a compute pass (``unpack_rgb8.comp``) instead of by the driver. On an
-        #: NVIDIA H100 the upload of a 4096 x 4096 RGB pair took 14-16 ms against 60-70 ms
+        #: NVIDIA H100 the upload of a 4096 x 4096 RGB pair took 14-16 ms against 60-78 ms
         #: as RGB texture writes (the driver expands the rows on the CPU, 3.5 GB/s); on
         #: llvmpipe the pass cost more than the driver's expansion (5.1 against 0.8 ms at
         #: 1024 x 1024), so GPUs on the compute path only. The tests switch it on to check it
