@@ -165,8 +165,9 @@ def test_a_grey_drawing_stretched_in_its_encoded_values_is_kept():
         np.testing.assert_array_equal(aarecovery.recover(original, filtered, engine=engine), filtered)
 
 
-def family_as_jpeg(name, width, quality):
-    """A real-tools drawing family antialiased in sRGB values, saved as a JPEG by Pillow.
+def family_as_jpeg(name, width, quality, space="srgb"):
+    """A real-tools drawing family antialiased in `space` ("srgb" values or "linear" light),
+    saved as a JPEG by Pillow.
 
     Returns
     -------
@@ -180,7 +181,7 @@ def family_as_jpeg(name, width, quality):
     from aarecovery.lab.realtools import FAMILIES, render_family
     from aarecovery.plan.resample import box_downsample
     scene = np.rint(render_family(name, width) * 255).astype(np.uint8)
-    clean = np.rint(box_downsample(scene.astype(np.float32) / 255, FAMILIES[name].k, "srgb") * 255).astype(np.uint8)
+    clean = np.rint(box_downsample(scene.astype(np.float32) / 255, FAMILIES[name].k, space) * 255).astype(np.uint8)
     buffer = io.BytesIO()
     Image.fromarray(clean).save(buffer, format="JPEG", quality=quality)
     with Image.open(io.BytesIO(buffer.getvalue())) as decoded:

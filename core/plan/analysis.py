@@ -249,7 +249,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         grain = paper_grain(o, f)
         prior = pure_colour_prior(o, transfer, space, f, edges,
                                   noise_contrast=max(compression.contrast, grain.contrast),
-                                  extend_ends=not compression.compressed)
+                                  extend_ends=not compression.compressed, ridge_noise=compression.contrast)
         thin = ", pure colours of thin features" if prior is not None else ""
         if compression.compressed or grain.coarse:
             # A JPEG's noise goes through the filter too (a levels curve doubles it): full
@@ -310,7 +310,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # graphics 0.414 -> 0.446; per case -0.072 (the poster under G'MIC's pow 3) to +0.180;
         # the grey camera photo and text page (excluded) and no other case moved by over 0.01.
         prior = drawn_only(pure_colour_prior(o, transfer, space, f, edges, noise_contrast=compression.contrast,
-                                             extend_ends=not compression.compressed), o, edges, ink=not grey)
+                                             extend_ends=not compression.compressed, ridge_noise=compression.contrast),
+                           o, edges, ink=not grey)
         thin = ", pure colours of thin features there" if prior is not None else ""
         return PairAnalysis(space, 1.0, why + " for textured regions, full strength for hard-edged ones" + thin,
                             Decision.POINTWISE_CALIBRATED, prior, local=LocalStrength(strength))

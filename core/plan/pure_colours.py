@@ -186,7 +186,7 @@ def affine_in_key_miss(original, filtered, edges, key):
 
 
 def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None, noise_contrast=0.0,
-                      extend_ends=True):
+                      extend_ends=True, ridge_noise=0.0):
     """The prior for the passes, from the first fitted table fit for the extension.
 
     Keys often tie (a threshold of black/white text matches per channel and by luma); the
@@ -210,6 +210,9 @@ def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None
     extend_ends : bool, optional
         Extrapolate the table past O's key range (:func:`extrapolate_table`); False for a
         JPEG-compressed O, whose range ends at its ringing.
+    ridge_noise : float, optional
+        O's compression noise as a contrast, which a thin feature's ridge must also stand out
+        from (``PureColourPrior.ridge_noise``); 0 for an uncompressed O.
 
     Returns
     -------
@@ -233,6 +236,7 @@ def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None
     if not fit:
         return None
     priors = [PureColourPrior(candidate.key, palette=palette, noise_contrast=float(noise_contrast),
+                              ridge_noise=float(ridge_noise),
                               **_extrapolated(original, candidate, extend_ends))
               for candidate in fit
               if candidate.consistency >= fit[0].consistency and candidate.mean_miss <= fit[0].mean_miss + _TIE_MISS]

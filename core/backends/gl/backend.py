@@ -487,7 +487,7 @@ class GLBackend:
         low, high = prior.key_range()
         return dict(palette_size=len(colours), palette=[tuple(map(float, colour)) for colour in palette],
                     key_low=tuple(map(float, low)), key_high=tuple(map(float, high)),
-                    noise_contrast=float(prior.noise_contrast))
+                    noise_contrast=float(prior.noise_contrast), ridge_noise=float(prior.ridge_noise))
 
     def _fit_blend_model(self, sources, uniforms, defines, lists, maps):
         """The model and the first Jacobi iterate (and the edge map, the Jacobi steps' constant with pure colours)."""

@@ -8,6 +8,7 @@ uniform int palette_size;
 uniform vec3 key_low;              // O's key range (bin centres of the table's first and last
 uniform vec3 key_high;             // filled bins, per column); beyond it the table is extrapolated
 uniform float noise_contrast;      // O's compression noise as a contrast (0: not compressed)
+uniform float ridge_noise;         // the same, for the ridge test (0: not compressed; no grain)
 // PURE_GATE: 1: the prior acts on drawn content only, `gate` (the local plan's region
 //            weight, 0 to 1) of the way (PureColourPrior.drawn_only)
 #ifndef PURE_GATE
@@ -46,6 +47,7 @@ uniform float noise_contrast;      // O's compression noise as a contrast (0: no
 const float PALETTE_TOLERANCE = 0.03;
 const float LINE_TOLERANCE = 0.05;
 const float RIDGE_MARGIN = 0.1001;
+const float RIDGE_NOISE_MARGIN = 1.5;
 const float EXPLAIN_TOLERANCE = 0.02;
 const float ON_LINE_TOLERANCE = 0.15;
 const float KEPT_CONTRAST = 0.5;
@@ -215,7 +217,8 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
         || !(moved_along >= KEPT_CONTRAST * len)) return result;
 #endif
     float t_far = dot(far - near, direction);
-    float margin = RIDGE_MARGIN * len;
+    // Past the noise's contrast too (RIDGE_NOISE_MARGIN in the twin says why).
+    float margin = max(RIDGE_MARGIN * len, RIDGE_NOISE_MARGIN * ridge_noise);
     // Opposite pairs of q's neighbours, N/S, W/E, NW/SE, NE/SW, written out: indexing an
     // array with a loop variable makes llvmpipe spill it to memory.
     bool ridge = lower_pair(q + OFFSETS[1], q + OFFSETS[4], near, direction, t_far - margin, size)
