@@ -81,6 +81,8 @@ HARD_EDGED_SHARE = 0.3
 #: and the span within which a photo's neighbouring levels lie (fewer than half as many
 #: pixels there as recurrences).
 INK_RADIUS = 3
+# Two on colour images lifted the mixed scenes' text (tuning 0.530 -> 0.560) but opened the
+# gate on photos: held out, photo regions worse than F 3 -> 6 (docs/safe-default.md).
 INK_REPEATS = 3
 INK_NEAR_SPAN = 3.5 / 255
 #: Ink whose brightest channel is at most this is no evidence (a camera's clipped shadows).
