@@ -199,7 +199,7 @@ def test_drawn_ink_repairs_a_caption_on_the_photo_and_leaves_the_photo_alone(fil
         engine.run(plan)
         results["gl"] = engine.result()
     # Before it: the flat share alone.
-    monkeypatch.setattr(local_plan, "ink_weight", lambda encoded: np.zeros(encoded.shape[:2], np.float32))
+    monkeypatch.setattr(local_plan, "ink_weight", lambda encoded, shares=None: np.zeros(encoded.shape[:2], np.float32))
     with aarecovery.Engine("numpy") as engine:
         engine.set_images(case.original, case.filtered)
         engine.run(plan)
@@ -281,3 +281,21 @@ def test_the_ink_gate_is_the_same_tiled_and_untiled(poster_scene, gl_path):
         for tile in (None, 48):
             parity.assert_results_agree(aarecovery.recover(*pair, engine=engine, tile_size=tile), whole,
                                         f"{gl_path} tile {tile}")
+
+
+def test_the_gate_of_pure_colours_opens_beside_a_stroke_where_the_strength_does_not():
+    """The pixel beside a stroke holds a fifth of its ink: the strength leaves it at the
+    photo's factor (its share is below INK_SHARE_LOW), the gate of pure colours opens there
+    (from INK_GATE_SHARE_LOW), so that the stroke's partial colour can take its pure colour."""
+    rng = np.random.default_rng(3)
+    photo = np.clip(0.75 + rng.normal(0, 0.04, (15, 15, 3)), 0, 1).astype(np.float32)
+    ink = np.array([0.2, 0.3, 0.8], np.float32)
+    image = photo.copy()
+    image[:, 6:8] = ink
+    image[:, 8] = 0.2 * ink + 0.8 * photo[:, 8]
+    beside = (slice(4, 11), 8)
+    local = local_plan.LocalStrength(0.5)
+    assert np.all(local_plan.ink_weight(image)[beside] == 0)
+    assert np.all(local.factor(image)[beside] == 0.5)
+    assert np.all(local.gate(image, True)[beside] > 0.5)
+    assert np.all(local.gate(image, False)[beside] == 0)

@@ -16,6 +16,8 @@ const float INK_DARK = 5.0 / 255.0;
 const float INK_TIE = 0.25 / 255.0;
 const float INK_SHARE_LOW = 0.3;
 const float INK_SHARE_HIGH = 0.7;
+const float INK_GATE_SHARE_LOW = 0.0;
+const float INK_GATE_SHARE_HIGH = 0.3;
 
 uniform sampler2D original_image;  // O as uploaded (passes 1 and 3)
 uniform sampler2D local_input;     // the previous pass's output (passes 2 and 3)
@@ -33,8 +35,9 @@ vec3 original_encoded(ivec2 p, ivec2 size) {
 
 // 1 where the pixel holds drawn ink: an extreme of its 3 x 3 neighbourhood whose colour
 // recurs exactly in the 7 x 7 square (its part inside the image), with few colours a few
-// levels from it, and not near black; smooth in the pixel's share of that ink.
-float ink_weight(ivec2 p, ivec2 size) {
+// levels from it, and not near black; smooth in the pixel's share of that ink, at the
+// strength's shares (.x) and at the gate's (.y).
+vec2 ink_weight(ivec2 p, ivec2 size) {
     vec3 brightest = vec3(0.0);
     vec3 darkest = vec3(0.0);
     float high = -1.0;
@@ -65,7 +68,7 @@ float ink_weight(ivec2 p, ivec2 size) {
         }
     }
     vec3 centre = original_encoded(p, size);
-    float weight = 0.0;
+    vec2 weight = vec2(0.0);
     for (int side = 0; side < 2; ++side) {
         vec3 ink = side == 0 ? brightest : darkest;
         vec3 other = side == 0 ? darkest : brightest;
@@ -76,7 +79,8 @@ float ink_weight(ivec2 p, ivec2 size) {
         float span = sqrt(across.r * across.r + across.g * across.g + across.b * across.b);
         float share = span > 0.0 ? 1.0 - sqrt(from_ink.r * from_ink.r + from_ink.g * from_ink.g
                                               + from_ink.b * from_ink.b) / span : 0.0;
-        float t = clamp((share - INK_SHARE_LOW) / (INK_SHARE_HIGH - INK_SHARE_LOW), 0.0, 1.0);
+        vec2 t = clamp((vec2(share) - vec2(INK_SHARE_LOW, INK_GATE_SHARE_LOW))
+                       / vec2(INK_SHARE_HIGH - INK_SHARE_LOW, INK_GATE_SHARE_HIGH - INK_GATE_SHARE_LOW), 0.0, 1.0);
         if (drawn) weight = max(weight, t * t * (3.0 - 2.0 * t));
     }
     return weight;
@@ -122,9 +126,9 @@ vec2 local_plan(ivec2 p, ivec2 size) {
     float t = clamp((count / inside - TEXTURED_SHARE) / (HARD_EDGED_SHARE - TEXTURED_SHARE), 0.0, 1.0);
     float region = t * t * (3.0 - 2.0 * t);
     // The ink is at most 1: at a full region weight it changes neither value.
-    float ink = (drawn_ink != 0 || ink_gate != 0) && region < 1.0 ? ink_weight(p, size) : 0.0;
-    float weight = drawn_ink != 0 ? max(region, ink) : region;
-    float gate = ink_gate != 0 ? max(region, ink) : region;
+    vec2 ink = (drawn_ink != 0 || ink_gate != 0) && region < 1.0 ? ink_weight(p, size) : vec2(0.0);
+    float weight = drawn_ink != 0 ? max(region, ink.x) : region;
+    float gate = ink_gate != 0 ? max(region, ink.y) : region;
     return vec2(textured + (1.0 - textured) * weight, gate);
 #endif
 }
