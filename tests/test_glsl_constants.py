@@ -38,6 +38,7 @@ TWINS = {
     ("local_plan.glsl", "INK_SHARE_HIGH"): local_plan.INK_SHARE_HIGH,
     ("local_plan.glsl", "INK_GATE_SHARE_LOW"): local_plan.INK_GATE_SHARE_LOW,
     ("local_plan.glsl", "INK_GATE_SHARE_HIGH"): local_plan.INK_GATE_SHARE_HIGH,
+    ("local_plan.glsl", "INK_GATE_REPEATS"): local_plan.INK_GATE_REPEATS,
     ("working.glsl", "VISIBLE_COVERAGE"): working_space.VISIBLE_COVERAGE,
     ("blend_model.glsl", "TINY"): float(blend_model._TINY),
     ("blend_model.glsl", "FAINT"): float(blend_model._FAINT),

@@ -199,7 +199,7 @@ def test_drawn_ink_repairs_a_caption_on_the_photo_and_leaves_the_photo_alone(fil
         engine.run(plan)
         results["gl"] = engine.result()
     # Before it: the flat share alone.
-    monkeypatch.setattr(local_plan, "ink_weight", lambda encoded, shares=None: np.zeros(encoded.shape[:2], np.float32))
+    monkeypatch.setattr(local_plan, "ink_weight", lambda encoded, *options: np.zeros(encoded.shape[:2], np.float32))
     with aarecovery.Engine("numpy") as engine:
         engine.set_images(case.original, case.filtered)
         engine.run(plan)
@@ -299,3 +299,15 @@ def test_the_gate_of_pure_colours_opens_beside_a_stroke_where_the_strength_does_
     assert np.all(local.factor(image)[beside] == 0.5)
     assert np.all(local.gate(image, True)[beside] > 0.5)
     assert np.all(local.gate(image, False)[beside] == 0)
+
+
+def test_the_gate_of_pure_colours_needs_fewer_recurrences_of_the_ink_than_the_strength():
+    """Ink seen at two pixels (a dot, the end of a stroke) opens the gate (INK_GATE_REPEATS)
+    but gives no full strength (INK_REPEATS)."""
+    rng = np.random.default_rng(4)
+    image = np.clip(0.75 + rng.normal(0, 0.04, (11, 11, 3)), 0, 1).astype(np.float32)
+    image[5, 5:7] = [0.2, 0.3, 0.8]
+    local = local_plan.LocalStrength(0.5)
+    assert local_plan.INK_GATE_REPEATS == 2 < local_plan.INK_REPEATS
+    assert local.factor(image)[5, 5] == 0.5
+    assert local.gate(image, True)[5, 5] == 1

@@ -18,6 +18,7 @@ const float INK_SHARE_LOW = 0.3;
 const float INK_SHARE_HIGH = 0.7;
 const float INK_GATE_SHARE_LOW = 0.0;
 const float INK_GATE_SHARE_HIGH = 0.3;
+const int INK_GATE_REPEATS = 2;
 
 uniform sampler2D original_image;  // O as uploaded (passes 1 and 3)
 uniform sampler2D local_input;     // the previous pass's output (passes 2 and 3)
@@ -72,8 +73,9 @@ vec2 ink_weight(ivec2 p, ivec2 size) {
     for (int side = 0; side < 2; ++side) {
         vec3 ink = side == 0 ? brightest : darkest;
         vec3 other = side == 0 ? darkest : brightest;
-        bool drawn = equal[side] >= INK_REPEATS && 2 * near[side] <= equal[side]
-                     && max(ink.r, max(ink.g, ink.b)) > INK_DARK;
+        // The strength's test, then the gate's (fewer recurrences).
+        bool few_near = 2 * near[side] <= equal[side] && max(ink.r, max(ink.g, ink.b)) > INK_DARK;
+        bvec2 drawn = bvec2(few_near && equal[side] >= INK_REPEATS, few_near && equal[side] >= INK_GATE_REPEATS);
         vec3 across = other - ink;
         vec3 from_ink = centre - ink;
         float span = sqrt(across.r * across.r + across.g * across.g + across.b * across.b);
@@ -81,7 +83,7 @@ vec2 ink_weight(ivec2 p, ivec2 size) {
                                               + from_ink.b * from_ink.b) / span : 0.0;
         vec2 t = clamp((vec2(share) - vec2(INK_SHARE_LOW, INK_GATE_SHARE_LOW))
                        / vec2(INK_SHARE_HIGH - INK_SHARE_LOW, INK_GATE_SHARE_HIGH - INK_GATE_SHARE_LOW), 0.0, 1.0);
-        if (drawn) weight = max(weight, t * t * (3.0 - 2.0 * t));
+        weight = max(weight, mix(vec2(0.0), t * t * (3.0 - 2.0 * t), drawn));
     }
     return weight;
 }
