@@ -82,8 +82,9 @@ HARD_EDGED_SHARE = 0.3
 #: and the span within which a photo's neighbouring levels lie (fewer than half as many
 #: pixels there as recurrences).
 INK_RADIUS = 3
-# Two on colour images lifted the mixed scenes' text (tuning 0.530 -> 0.560) but opened the
-# gate on photos: held out, photo regions worse than F 3 -> 6 (docs/safe-default.md).
+# Two for the strength too (the gate takes two, INK_GATE_REPEATS) lifted the mixed scenes'
+# text further (tuning 0.530 -> 0.560, with both at two) but gave photos full strength:
+# held out, photo regions worse than F 3 -> 6 (docs/safe-default.md).
 INK_REPEATS = 3
 INK_NEAR_SPAN = 3.5 / 255
 #: Ink whose brightest channel is at most this is no evidence (a camera's clipped shadows).
