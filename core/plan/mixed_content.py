@@ -46,7 +46,10 @@ MIXED_DRAWN_SHARE = 0.1
 #: The share of a textured window's edge pixels where a prior that acts on drawn regions
 #: only would act (``LocalStrength.region_weight`` above 0, or the drawn ink with an ink
 #: gate) below which it is not made: it would change next to nothing and cost the prior's
-#: passes everywhere. The 4096 x 4096 bench photo's window reads 0 (with the ink too).
+#: passes everywhere. The 4096 x 4096 bench photo's window reads 0 (with the ink too). The
+#: ink is read here with the strength's test (``ink_weight_at``: three recurrences, from 0.3
+#: of the ink), stricter than the gate's own (``INK_GATE_REPEATS``, ``INK_GATE_SHARE_LOW``):
+#: which pairs get the prior did not change when the gate widened.
 DRAWN_REGION_SHARE = 0.01
 
 
@@ -84,7 +87,8 @@ def drawn_only(prior, encoded, edges, ink=False):
     -------
     PureColourPrior or None
         With ``drawn_only=True`` (and ``ink_gate=ink``) where at least
-        :data:`DRAWN_REGION_SHARE` of the edge pixels lie where the gate is open.
+        :data:`DRAWN_REGION_SHARE` of the edge pixels lie where the gate is open (its ink
+        read with the strength's stricter test, :data:`DRAWN_REGION_SHARE` says why).
     """
     if prior is None or not edges.any():
         return None
