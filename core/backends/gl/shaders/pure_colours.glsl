@@ -189,6 +189,21 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
     vec3 steps = abs(far_encoded - near_encoded);
     if (!(max(max(max(steps.r, steps.g), steps.b), abs(span.a)) >= max(MIN_CONTRAST, noise_contrast))) return result;
     if (q.x <= 0 || q.y <= 0 || q.x >= size.x - 1 || q.y >= size.y - 1) return result;
+    // The tests are all required, so their order is free: the ridge test first, as it fails
+    // for nearly every extreme (a shape's edge is no ridge), and llvmpipe skips what follows
+    // only where a whole group of pixels has failed; the palette's loop after it (it was
+    // half of the fit's time on the thin-features pair when it came first).
+    vec4 direction = span / len;
+    float t_far = dot(far - near, direction);
+    // Past the noise's contrast too (RIDGE_NOISE_MARGIN in the twin says why).
+    float margin = max(RIDGE_MARGIN * len, RIDGE_NOISE_MARGIN * ridge_noise);
+    // Opposite pairs of q's neighbours, N/S, W/E, NW/SE, NE/SW, written out: indexing an
+    // array with a loop variable makes llvmpipe spill it to memory.
+    bool ridge = lower_pair(q + OFFSETS[1], q + OFFSETS[4], near, direction, t_far - margin, size)
+              || lower_pair(q + OFFSETS[2], q + OFFSETS[3], near, direction, t_far - margin, size)
+              || lower_pair(q + OFFSETS[5], q + OFFSETS[8], near, direction, t_far - margin, size)
+              || lower_pair(q + OFFSETS[6], q + OFFSETS[7], near, direction, t_far - margin, size);
+    if (!ridge) return result;
     float tolerance_sq = PALETTE_TOLERANCE * PALETTE_TOLERANCE;
     // One loop over the palette for both extremes (a loop costs its full length on llvmpipe,
     // whatever its early exits).
@@ -208,7 +223,6 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
     vec4 explained = abs(filtered_colour_of(far, far_encoded, far_keys) - filtered_far);
     if (!(max(max(explained.r, explained.g), explained.b) < EXPLAIN_TOLERANCE)) return result;
 #endif
-    vec4 direction = span / len;
 #if !EXPLAIN_FILTERED
     // No fitted table: F at the extreme lies on O's colour line and keeps the contrast.
     vec4 moved = filtered_far - near;
@@ -216,16 +230,6 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
     if (!(dot(moved, moved) - moved_along * moved_along < ON_LINE_TOLERANCE * ON_LINE_TOLERANCE)
         || !(moved_along >= KEPT_CONTRAST * len)) return result;
 #endif
-    float t_far = dot(far - near, direction);
-    // Past the noise's contrast too (RIDGE_NOISE_MARGIN in the twin says why).
-    float margin = max(RIDGE_MARGIN * len, RIDGE_NOISE_MARGIN * ridge_noise);
-    // Opposite pairs of q's neighbours, N/S, W/E, NW/SE, NE/SW, written out: indexing an
-    // array with a loop variable makes llvmpipe spill it to memory.
-    bool ridge = lower_pair(q + OFFSETS[1], q + OFFSETS[4], near, direction, t_far - margin, size)
-              || lower_pair(q + OFFSETS[2], q + OFFSETS[3], near, direction, t_far - margin, size)
-              || lower_pair(q + OFFSETS[5], q + OFFSETS[8], near, direction, t_far - margin, size)
-              || lower_pair(q + OFFSETS[6], q + OFFSETS[7], near, direction, t_far - margin, size);
-    if (!ridge) return result;
 #if CLAMP_ENDS
     // An extreme that is O's darkest or brightest colour is pure (a paper between thin lines),
     // unless the other extreme is the opposite end or a flat colour (spec/pure_colours.extend_extreme).
