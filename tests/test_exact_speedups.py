@@ -173,84 +173,17 @@ def _analysed_pairs():
             "blur": (photo[0], apply("blur", photo[0])), "jpeg page": (page, apply("threshold", page))}
 
 
-class _InLine:
-    """Prefetch's calls made in the caller's thread when their result is asked for."""
-
-    def __init__(self, calls):
-        self._calls = dict(calls)
-
-    def result(self, name):
-        return self._calls[name]()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc_info):
-        return False
-
-
 @pytest.mark.parametrize("name", ["thin features", "photo-like", "blur", "jpeg page"])
-@pytest.mark.parametrize("plainly", ["BLAS as it is", "in line"])
-def test_the_plan_made_faster_is_the_plan_made_plainly(name, plainly, monkeypatch):
-    """One BLAS thread, and part of the analysis in a second thread (plan/prefetch.py)."""
+def test_the_plan_with_one_blas_thread_is_the_plan_with_blas_as_it_is(name, monkeypatch):
     from contextlib import nullcontext
 
     import aarecovery.plan as plan_layer
     from aarecovery.params import Parameters
-    from aarecovery.plan import analysis
 
     original, filtered = _analysed_pairs()[name]
-    faster = plan_layer.make_plan(original, filtered, Parameters())
-    if plainly == "BLAS as it is":
-        monkeypatch.setattr(plan_layer, "one_blas_thread", nullcontext)
-    else:
-        monkeypatch.setattr(analysis, "Prefetch", _InLine)
-    _same(faster, plan_layer.make_plan(original, filtered, Parameters()))
-
-
-def test_the_point_wise_fit_in_two_parts_is_the_fit_in_one():
-    from aarecovery.plan.analysis import _KEYS_BESIDE
-
-    original, filtered = _analysed_pairs()["photo-like"]
-    o, f = original[..., :3].astype(np.float32) / 255, filtered[..., :3].astype(np.float32) / 255
-    edges = np.zeros(o.shape[:2], bool)
-    edges[::3] = True
-    whole = pointwise.fit_pointwise(o, f, edges)
-    parted = pointwise.fit_pointwise(o, f, edges, fitted=pointwise.fit_keys(o, f, edges, _KEYS_BESIDE))
-    assert (whole.key, whole.consistency, whole.mean_miss) == (parted.key, parted.consistency, parted.mean_miss)
-    np.testing.assert_array_equal(whole.table, parted.table)
-    assert [t.key for t in whole.alternatives] == [t.key for t in parted.alternatives]
-
-
-def test_a_prefetched_call_hands_over_its_result_or_its_error_and_later_calls_are_skipped():
-    import threading
-
-    from aarecovery.plan.prefetch import Prefetch
-
-    started = threading.Event()
-    release = threading.Event()
-    made = []
-
-    def slow():
-        started.set()
-        release.wait(5)
-        made.append("slow")
-        return 2
-
-    def broken():
-        raise ValueError("O is broken")
-
-    with Prefetch([("one", lambda: 1), ("broken", broken)]) as prefetched:
-        assert prefetched.result("one") == 1
-        with pytest.raises(ValueError, match="O is broken"):
-            prefetched.result("broken")
-    # The chain returned while the second call ran: leaving waits for it, skips the third.
-    prefetched = Prefetch([("slow", slow), ("never", lambda: made.append("never"))])
-    with prefetched:
-        assert started.wait(5)
-        release.set()
-    assert made == ["slow"]
-    assert not prefetched._thread.is_alive()
+    limited = plan_layer.make_plan(original, filtered, Parameters())
+    monkeypatch.setattr(plan_layer, "one_blas_thread", nullcontext)
+    _same(limited, plan_layer.make_plan(original, filtered, Parameters()))
 
 
 def test_one_blas_thread_limits_blas_inside_and_restores_it():

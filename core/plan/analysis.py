@@ -70,7 +70,6 @@ from ..colour import linear_to_srgb
 from ..contract import layout_of, to_rgba_float
 from ..params import ITERATIONS, SIGMA_D, SIGMA_E
 from ..spec.local_plan import LocalStrength
-from ..spec.pure_colours import SCALE_KEYS, SHIFT_KEYS
 from ..spec.sobel import gradient_magnitude
 from .blend_space import choose_blend_space
 from .calibration import EDGE_GRADIENT, calibrate_strength
@@ -85,8 +84,7 @@ from .lowpass import fit_lowpass
 from .mixed_content import MIXED_DRAWN_SHARE, drawn_only, drawn_share
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
 from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, paper_grain
-from .pointwise import FITTED_KEYS, POINTWISE_SHARE, fit_keys, fit_pointwise
-from .prefetch import Prefetch
+from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import pure_colour_prior
 from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, UNTOUCHED_SPAN, contrast_ratio
 from .texture import is_grey, is_textured
@@ -115,9 +113,6 @@ _PHOTO_NEIGHBOURHOOD_STRENGTH = 0.0
 # (+0.5 to +1.9 dB), so the lower strength.
 _GREY_SHARPENED_STRENGTH = 0.25
 # The reasons' note of a smoothing filter's untouched edges (plan/smoothing.py).
-# The point-wise fit's keys fitted in the second thread (prefetch.py): about as long as
-# the rest of the main thread's work until it needs them.
-_KEYS_BESIDE = SHIFT_KEYS + SCALE_KEYS
 _UNTOUCHED = ", F kept where it left O's edges as they were"
 
 
@@ -205,27 +200,16 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     """
     o_rgba = analysis_crop(original_rgba)
     f_rgba = analysis_crop(filtered_rgba)
-    # The analysis past the blend space is on sRGB-encoded colour, as filters see it.
+    space, residuals = choose_blend_space(o_rgba, linear_input)
+    # The remaining analysis is on sRGB-encoded colour, as filters see it.
     o = o_rgba[..., :3] if not linear_input else linear_to_srgb(o_rgba[..., :3])
     f = f_rgba[..., :3] if not linear_input else linear_to_srgb(f_rgba[..., :3])
-    # The low-pass fit and the JPEG grid search need only the pair: they run beside the chain
-    # (prefetch.py). Measured: docs/performance.md.
-    # So do the luma-shift and scale keys of the point-wise fit, a third of its time.
-    with Prefetch([("lowpass", lambda: fit_lowpass(o, f)),
-                   ("compression", lambda: compression_evidence(o, quantization)),
-                   ("beside keys", lambda: fit_keys(o, f, _edges(o), _KEYS_BESIDE))]) as prefetched:
-        return _decide(o_rgba, f_rgba, o, f, prefetched, linear_input, sigma_d, sigma_e, iterations)
-
-
-def _decide(o_rgba, f_rgba, o, f, prefetched, linear_input, sigma_d, sigma_e, iterations):
-    """The chain of exits of :func:`analyse` (the module's docstring lists them)."""
-    space, residuals = choose_blend_space(o_rgba, linear_input)
     fit = residuals[space]
-    lowpass, kernel_residual, _ = prefetched.result("lowpass")
+    lowpass, kernel_residual, _ = fit_lowpass(o, f)
     if lowpass:
         return PairAnalysis(space, 0.0, f"F is a low-pass (blur) of O (kernel residual {kernel_residual:.3f}): kept F",
                             Decision.LOWPASS_KEPT, forcing=forcing_advice(Decision.LOWPASS_KEPT))
-    edges = _edges(o)
+    edges = gradient_magnitude(o) >= EDGE_GRADIENT
     # A grey (or faintly tinted) O cannot tell its antialiasing space (blend_space falls back to linear light), so
     # an affine map of its encoded values (Pillow's autocontrast, a levels stretch) is tested
     # too: tuning half, the screentone manga under Pillow's autocontrast, affine in sRGB values
@@ -240,9 +224,8 @@ def _decide(o_rgba, f_rgba, o, f, prefetched, linear_input, sigma_d, sigma_e, it
             return PairAnalysis(space, 0.0, f"F is an affine map of O in {affine_space} values on {affine:.3f} of the "
                                             "edges, so its edges are already right: kept F", Decision.AFFINE_KEPT,
                                 forcing=forcing_advice(Decision.AFFINE_KEPT))
-    fitted = fit_keys(o, f, edges, [key for key in FITTED_KEYS if key not in _KEYS_BESIDE])
-    transfer = fit_pointwise(o, f, edges, fitted={**fitted, **prefetched.result("beside keys")})
-    compression = prefetched.result("compression")
+    transfer = fit_pointwise(o, f, edges)
+    compression = compression_evidence(o, quantization)
     textured, texture = is_textured(o, fit, compression)
     # A comic's screentone reads as texture, but it is a drawing (plan/hatching.py): under a
     # point-wise filter it takes the hard-edged branch below, as under a neighbourhood filter.
@@ -470,10 +453,6 @@ def _decide(o_rgba, f_rgba, o, f, prefetched, linear_input, sigma_d, sigma_e, it
         return PairAnalysis(space, SMOOTHED_STRENGTH, why + f": a smoothing filter, strength {SMOOTHED_STRENGTH:g}"
                             + pure + _UNTOUCHED, Decision.NEIGHBOURHOOD_HARD_EDGED, prior, **untouched)
     return PairAnalysis(space, 1.0, why + ": full strength" + pure, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
-
-
-def _edges(o):
-    return gradient_magnitude(o) >= EDGE_GRADIENT
 
 
 def _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e):

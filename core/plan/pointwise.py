@@ -12,7 +12,7 @@ import numpy as np
 from ..colour import LUMA, REC601_LUMA, largest_channel, luma, srgb_to_linear
 from ..spec.pure_colours import LUMINANCE_KEYS, SCALE_KEYS, SHIFT_KEYS, key_values, scale_transfer, shift_grey
 
-__all__ = ["PointwiseTransfer", "fit_pointwise", "fit_keys", "FITTED_KEYS", "filled_bins", "key_of", "POINTWISE_SHARE", "TABLE_KEYS"]
+__all__ = ["PointwiseTransfer", "fit_pointwise", "filled_bins", "key_of", "POINTWISE_SHARE", "TABLE_KEYS"]
 
 # Point-wise fit: bins of the table, tolerance of a match and the share of edge pixels that
 # must match. Point-wise filters of the suite score >= 0.99; neighbourhood filters <= 0.8.
@@ -96,12 +96,7 @@ class PointwiseTransfer:
         return self.table[index]
 
 
-#: Every key that :func:`fit_pointwise` tries, in the order that decides ties: the table
-#: keys, then the luma shifts, then the scale keys.
-FITTED_KEYS = TABLE_KEYS + tuple(SHIFT_KEYS) + tuple(SCALE_KEYS)
-
-
-def fit_pointwise(original, filtered, edges, fitted=None):
+def fit_pointwise(original, filtered, edges):
     """Fit ``F = f(O)`` by bin means and score it on edge pixels.
 
     Parameters
@@ -110,65 +105,29 @@ def fit_pointwise(original, filtered, edges, fitted=None):
         Encoded colour.
     edges : ndarray of bool, shape (H, W)
         Where to score the fit.
-    fitted : dict of str to PointwiseTransfer, optional
-        Candidates already fitted for some keys (:func:`fit_keys` on the same pair, as the
-        analysis runs part of them in a second thread); the other keys are fitted here.
 
     Returns
     -------
     PointwiseTransfer
-        The key with the best consistency (the first of equal ones in :data:`FITTED_KEYS`);
-        its ``alternatives`` attribute lists every key's transfer, best first.
+        The key with the best consistency (the first of equal ones); its ``alternatives``
+        attribute lists every key's transfer, best first.
     """
-    fitted = dict(fitted or {})
-    fitted.update(fit_keys(original, filtered, edges, [key for key in FITTED_KEYS if key not in fitted]))
-    candidates = [fitted[key] for key in FITTED_KEYS]
-    best = candidates[0]
-    for transfer in candidates[1:]:
-        if _better(transfer, best):
-            best = transfer
-    best.alternatives = sorted(candidates, key=lambda t: (-t.consistency, t.mean_miss))
-    return best
-
-
-def fit_keys(original, filtered, edges, keys):
-    """Each key's candidate transfer, scored on the edge pixels (see :func:`fit_pointwise`).
-
-    Returns
-    -------
-    dict of str to PointwiseTransfer
-        One per key of `keys` (a scale key's best of its tables).
-    """
-    fitted = {}
+    best = None
+    fitted = []
     # Tables are fitted on every pixel but scored on the edge pixels only: scoring a dozen
     # candidate tables on the whole crop took half of the analysis (measured).
     scored = edges if edges.any() else np.ones(edges.shape, bool)
     scored_o, scored_f = original[scored], filtered[scored]
 
-    def scored_transfer(key, table):
-        transfer = PointwiseTransfer(key, table, 0.0)
+    def consistency(transfer):
         miss = largest_channel(np.abs(transfer(scored_o) - scored_f))
         # Ties (two colours fit any key) go to the key that reproduces F more closely.
         transfer.mean_miss = float(miss.mean())
-        transfer.consistency = float((miss <= _LUT_TOLERANCE).mean())
-        return transfer
+        return float((miss <= _LUT_TOLERANCE).mean())
 
     # F's channels as the weights bincount converts them to, once for every key.
-    weights = None
-    for key in keys:
-        if key in SHIFT_KEYS:
-            fitted[key] = scored_transfer(key, _shift_table(original, filtered, key))
-            continue
-        if key in SCALE_KEYS:
-            chosen = None
-            for table in _scale_tables(original, filtered, key):
-                transfer = scored_transfer(key, table)
-                if chosen is None or _better(transfer, chosen):
-                    chosen = transfer
-            fitted[key] = chosen
-            continue
-        if weights is None:
-            weights = [filtered[..., c].ravel().astype(np.float64) for c in range(3)]
+    weights = [filtered[..., c].ravel().astype(np.float64) for c in range(3)]
+    for key in TABLE_KEYS:
         values = key_of(original, key)
         index = _bins(values)
         table = np.empty((_LUT_BINS, 3), np.float32)
@@ -180,8 +139,29 @@ def fit_keys(original, filtered, edges, keys):
             filled = counts > 0
             centres = np.arange(_LUT_BINS)
             table[:, c] = np.interp(centres, centres[filled], sums[filled] / counts[filled]) if filled.any() else 0
-        fitted[key] = scored_transfer(key, table)
-    return fitted
+        transfer = PointwiseTransfer(key, table, 0.0)
+        transfer.consistency = consistency(transfer)
+        fitted.append(transfer)
+        if best is None or _better(transfer, best):
+            best = transfer
+    for key in SHIFT_KEYS:
+        transfer = PointwiseTransfer(key, _shift_table(original, filtered, key), 0.0)
+        transfer.consistency = consistency(transfer)
+        fitted.append(transfer)
+        if _better(transfer, best):
+            best = transfer
+    for key in SCALE_KEYS:
+        chosen = None
+        for table in _scale_tables(original, filtered, key):
+            transfer = PointwiseTransfer(key, table, 0.0)
+            transfer.consistency = consistency(transfer)
+            if chosen is None or _better(transfer, chosen):
+                chosen = transfer
+        fitted.append(chosen)
+        if _better(chosen, best):
+            best = chosen
+    best.alternatives = sorted(fitted, key=lambda t: (-t.consistency, t.mean_miss))
+    return best
 
 
 def _grey601(colour, key):
