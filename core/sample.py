@@ -22,8 +22,6 @@ fitted kernel is no longer low-pass), so the paper's passes would re-sharpen the
 Threshold and gamma were decided alike either way.
 """
 
-from concurrent.futures import ThreadPoolExecutor
-
 import numpy as np
 
 from .colour import luma
@@ -100,36 +98,22 @@ def analysis_sample(read_original, read_filtered, height, width):
     return read_original(rows, cols), read_filtered(rows, cols)
 
 
-def analysis_window(read_original, height, width, threads=1):
+def analysis_window(read_original, height, width):
     """The rows and columns (two slices) of the window :func:`analysis_sample` reads: the
-    candidate of :func:`analysis_windows` with the most edge pixels in O.
-
-    `threads`: how many windows are scored at once; more than one only where
-    `read_original` may be called from several threads (an array in memory)."""
+    candidate of :func:`analysis_windows` with the most edge pixels in O."""
     windows = analysis_windows(height, width)
     if len(windows) == 1:
         return windows[0]
-
-    def score(window):
-        return _edge_pixels(read_original(*window))
-
     # Each window's luma is a matrix product: with BLAS's threads spinning between the 65 of
     # a large image they cost CPU and no time (plan/blas.py).
     with one_blas_thread():
-        if threads > 1:
-            with ThreadPoolExecutor(threads, thread_name_prefix="aarecovery-window") as pool:
-                scores = list(pool.map(score, windows))
-        else:
-            scores = [score(window) for window in windows]
+        scores = [_edge_pixels(read_original(rows, cols)) for rows, cols in windows]
     return windows[int(np.argmax(scores))]
 
 
 def array_window(original):
-    """:func:`analysis_window` of an image held in memory: its rows and columns (two slices).
-
-    Two windows are scored at once (NumPy releases the GIL): 4096 x 4096, 65 windows, 43 ->
-    25 ms on two cores (docs/performance.md)."""
-    return analysis_window(lambda rows, cols: original[rows, cols], *original.shape[:2], threads=2)
+    """:func:`analysis_window` of an image held in memory: its rows and columns (two slices)."""
+    return analysis_window(lambda rows, cols: original[rows, cols], *original.shape[:2])
 
 
 def array_sample(original, filtered):

@@ -132,21 +132,6 @@ def test_the_analysis_window_is_the_one_with_most_edges_and_spans_the_image():
     assert reads[-1] == windows[0] and sample[0].shape == (512, 512)
 
 
-def test_windows_scored_in_two_threads_pick_the_window_of_one_thread():
-    from aarecovery.sample import analysis_window
-
-    rng = np.random.default_rng(3)
-    original = np.full((1800, 2300, 3), 200, np.uint8)
-    for _ in range(40):  # patches of noise of random sizes: every window scores differently
-        top, left = rng.integers(0, 1700), rng.integers(0, 2200)
-        size = rng.integers(5, 100)
-        original[top:top + size, left:left + size] = rng.integers(0, 256, (size, size, 3)).astype(np.uint8)[
-            :1800 - top, :2300 - left]
-    read = lambda rows, cols: original[rows, cols]  # noqa: E731
-    one = analysis_window(read, 1800, 2300)
-    assert analysis_window(read, 1800, 2300, threads=2) == one != analysis_windows(1800, 2300)[0]
-
-
 def test_a_long_streamed_write_keeps_its_part_while_another_run_tidies_the_folder(tmp_path):
     """A gigapixel write takes minutes; a batch or recover beside it removes stale parts of
     writers that are gone. The streamed writer's part is locked, so it is not taken for one."""
