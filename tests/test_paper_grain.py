@@ -136,3 +136,30 @@ def test_a_light_grain_that_the_filter_makes_coarse_is_repaired_as_a_coarse_one(
     plan = recover_no_worse_than_f(case)
     expected = Decision.POINTWISE_HARD_EDGED_GRAINED if grained else Decision.POINTWISE_HARD_EDGED
     assert plan.decision == expected, plan.reason
+
+
+def test_a_sharpened_coarse_grain_keeps_its_sharpening_on_the_bare_paper():
+    """An unsharp mask sharpens a coarse paper grain, and the reference keeps it sharpened:
+    at the user's sigma_e the repair took it back beside the letters (haze: paper made darker
+    than F). At the sharpened grain's sigma_e, full strength, the haze falls by over half and
+    the letters are still repaired."""
+    from dataclasses import replace
+
+    from aarecovery.lab import realtools
+    from aarecovery.lab.metrics import haze_pixels
+    from aarecovery.plan.paper_grain import SHARPENED_GRAIN_EDGE_SCALE
+    from test_realtools import require_tool
+    require_tool(realtools.TOOL_FILTERS["im-unsharp"].tool)
+    suite = realtools.RealToolsSuite("grain", ("notice",), ("im-unsharp",), 96, {"notice": ("linear",)})
+    (case,) = realtools.build_cases(suite, "tune", jpeg=False)
+    plan = recover_no_worse_than_f(case)
+    assert plan.decision == Decision.NEIGHBOURHOOD_HARD_EDGED and plan.strength == 1, plan.reason
+    assert plan.sigma_e == pytest.approx(SIGMA_E.default * SHARPENED_GRAIN_EDGE_SCALE), plan.reason
+    hazes = []
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        for sigma_e in (plan.sigma_e, SIGMA_E.default):
+            engine.run(replace(plan, sigma_e=sigma_e))
+            hazes.append(haze_pixels(engine.result()[..., :3], case.filtered, case.paper))
+    scaled, users = hazes
+    assert users > 50 and scaled < users / 2, hazes
