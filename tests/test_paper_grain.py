@@ -163,3 +163,27 @@ def test_a_sharpened_coarse_grain_keeps_its_sharpening_on_the_bare_paper():
             hazes.append(haze_pixels(engine.result()[..., :3], case.filtered, case.paper))
     scaled, users = hazes
     assert users > 50 and scaled < users / 2, hazes
+
+
+def test_the_grains_sigma_e_stays_below_the_letters_edge_strength_under_a_solarize():
+    """Pillow's solarize inverts the paper toward the ink: the letters' edge strength falls
+    to 0.04-0.07, and at 10 times the user's sigma_e their repair lost most of its confidence
+    (notice 0.41 of the edge error); capped at the letters' edge strength, 0.59."""
+    from dataclasses import replace
+
+    from aarecovery.lab import realtools
+    from aarecovery.lab.metrics import error_reduction
+    suite = realtools.RealToolsSuite("grain", ("notice",), ("pil-solarize",), 96, {"notice": ("srgb",)})
+    (case,) = realtools.build_cases(suite, "tune", jpeg=False)
+    plan = recover_no_worse_than_f(case)
+    assert plan.decision == Decision.POINTWISE_HARD_EDGED_GRAINED, plan.reason
+    assert SIGMA_E.default < plan.sigma_e < SIGMA_E.default * GRAIN_EDGE_SCALE * 0.8, plan.sigma_e
+    band = edge_band(case.original, case.filtered, case.reference)
+    reductions = []
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        for sigma_e in (plan.sigma_e, SIGMA_E.default * GRAIN_EDGE_SCALE):
+            engine.run(replace(plan, sigma_e=sigma_e))
+            reductions.append(error_reduction(engine.result()[..., :3], case.filtered, case.reference, band))
+    capped, uncapped = reductions
+    assert capped > 0.5 and capped > uncapped + 0.1, reductions

@@ -83,7 +83,7 @@ from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
 from .mixed_content import MIXED_DRAWN_SHARE, drawn_only, drawn_share
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
-from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, SHARPENED_GRAIN_EDGE_SCALE, paper_grain
+from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, SHARPENED_GRAIN_EDGE_SCALE, grain_edge_scale, paper_grain
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import pure_colour_prior
 from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, UNTOUCHED_SPAN, contrast_ratio
@@ -262,8 +262,10 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
             # colours above the grain), calibrated none (its mean 0.25 -> 0.58).
             # On a coarse grain the passes also run at a larger sigma_e (grain.edge_scale), so
             # that the grain's weak edges get little confidence and the bare paper stays as F
-            # has it; the calibration runs at the user's: at the larger scale it chose
-            # strengths that lost up to 0.9 dB on the tuning half's grained page.
+            # has it, but not above the edge strength of O's strongest edges, which a curve that
+            # brings the paper toward the ink (a solarize) makes weak too (grain_edge_scale);
+            # the calibration runs at the user's: at the larger scale it chose strengths that
+            # lost up to 0.9 dB on the tuning half's grained page.
             strength, errors = calibrate_strength(o, transfer, f, space, sigma_d, sigma_e, iterations)
             if compression.compressed:
                 decision, above = Decision.POINTWISE_HARD_EDGED_COMPRESSED, compression.describe()
@@ -274,7 +276,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                 f"on hard-edged content{thin} above {above}; half-resolution "
                                 f"calibration chose strength {strength:g}", decision, prior,
                                 forcing=forcing_advice(decision, errors=errors) if strength == 0 else None,
-                                edge_scale=grain.edge_scale)
+                                edge_scale=grain_edge_scale(grain, o, f, edges, space, sigma_e))
         return PairAnalysis(space, 1.0, f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges "
                                         f"match) on hard-edged content: full strength{thin}",
                             Decision.POINTWISE_HARD_EDGED, prior)
