@@ -141,28 +141,33 @@ def test_a_light_grain_that_the_filter_makes_coarse_is_repaired_as_a_coarse_one(
 def test_a_sharpened_coarse_grain_keeps_its_sharpening_on_the_bare_paper():
     """An unsharp mask sharpens a coarse paper grain, and the reference keeps it sharpened:
     at the user's sigma_e the repair took it back beside the letters (haze: paper made darker
-    than F). At the sharpened grain's sigma_e, full strength, the haze falls by over half and
-    the letters are still repaired."""
+    than F). At the grain's sigma_e the haze falls by over half; blended in linear light
+    (the grain keeps the strokes from their pure colours) the letters gain more than in
+    the sRGB values the page was antialiased in."""
     from dataclasses import replace
 
     from aarecovery.lab import realtools
-    from aarecovery.lab.metrics import haze_pixels
-    from aarecovery.plan.paper_grain import SHARPENED_GRAIN_EDGE_SCALE
+    from aarecovery.lab.metrics import error_reduction, haze_pixels
     from test_realtools import require_tool
     require_tool(realtools.TOOL_FILTERS["im-unsharp"].tool)
-    suite = realtools.RealToolsSuite("grain", ("notice",), ("im-unsharp",), 96, {"notice": ("linear",)})
+    suite = realtools.RealToolsSuite("grain", ("notice",), ("im-unsharp",), 96, {"notice": ("srgb",)})
     (case,) = realtools.build_cases(suite, "tune", jpeg=False)
     plan = recover_no_worse_than_f(case)
     assert plan.decision == Decision.NEIGHBOURHOOD_HARD_EDGED and plan.strength == 1, plan.reason
-    assert plan.sigma_e == pytest.approx(SIGMA_E.default * SHARPENED_GRAIN_EDGE_SCALE), plan.reason
-    hazes = []
+    assert plan.sigma_e == pytest.approx(SIGMA_E.default * GRAIN_EDGE_SCALE), plan.reason
+    assert plan.blend_space == "linear", plan.reason
+    band = edge_band(case.original, case.filtered, case.reference)
+    measured = {}
     with aarecovery.Engine("numpy") as engine:
         engine.set_images(case.original, case.filtered)
-        for sigma_e in (plan.sigma_e, SIGMA_E.default):
-            engine.run(replace(plan, sigma_e=sigma_e))
-            hazes.append(haze_pixels(engine.result()[..., :3], case.filtered, case.paper))
-    scaled, users = hazes
-    assert users > 50 and scaled < users / 2, hazes
+        for name, variant in (("plan", plan), ("user's sigma_e", replace(plan, sigma_e=SIGMA_E.default)),
+                              ("sRGB", replace(plan, blend_space="srgb"))):
+            engine.run(variant)
+            result = engine.result()[..., :3]
+            measured[name] = (haze_pixels(result, case.filtered, case.paper),
+                              error_reduction(result, case.filtered, case.reference, band))
+    assert measured["user's sigma_e"][0] > 20 and measured["plan"][0] < measured["user's sigma_e"][0] / 2, measured
+    assert measured["plan"][1] > measured["sRGB"][1] + 0.1, measured
 
 
 def test_the_grains_sigma_e_stays_below_the_letters_edge_strength_under_a_solarize():

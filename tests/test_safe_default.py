@@ -41,12 +41,18 @@ def _number_or_tuple(node):
 
 
 def _parse_value(text):
-    value = _number_or_tuple(ast.parse(text, mode="eval").body)
-    assert value is not None, f"docs/safe-default.md: value `{text}` is not a number, a ratio or a tuple of them"
+    node = ast.parse(text, mode="eval").body
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):  # a named choice (a blend space)
+        return node.value
+    value = _number_or_tuple(node)
+    assert value is not None, (f"docs/safe-default.md: value `{text}` is not a number, a ratio, a tuple of them or a "
+                               "quoted string")
     return value
 
 
 def _same(documented, actual):
+    if isinstance(documented, str):
+        return documented == actual
     if isinstance(documented, tuple):
         return (isinstance(actual, tuple) and len(actual) == len(documented)
                 and all(_same(d, a) for d, a in zip(documented, actual)))

@@ -83,7 +83,7 @@ from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
 from .mixed_content import MIXED_DRAWN_SHARE, drawn_only, drawn_share
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
-from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, SHARPENED_GRAIN_EDGE_SCALE, grain_edge_scale, paper_grain
+from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, SHARPENED_GRAIN_BLEND_SPACE, grain_edge_scale, paper_grain
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import pure_colour_prior
 from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, UNTOUCHED_SPAN, contrast_ratio
@@ -454,11 +454,13 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     if smoothing and prior is not None:
         return PairAnalysis(space, SMOOTHED_STRENGTH, why + f": a smoothing filter, strength {SMOOTHED_STRENGTH:g}"
                             + pure + _UNTOUCHED, Decision.NEIGHBOURHOOD_HARD_EDGED, prior, **untouched)
-    # A sharpening filter on a coarse grain sharpens the grain too: the passes run at a
-    # larger sigma_e there (SHARPENED_GRAIN_EDGE_SCALE), so that the bare paper keeps it.
+    # A sharpening filter on a coarse grain sharpens the grain too: the passes run at the
+    # grain's sigma_e, so that the bare paper keeps it, blended in linear light
+    # (SHARPENED_GRAIN_BLEND_SPACE says why).
     if grain.coarse:
-        return PairAnalysis(space, 1.0, why + f" that sharpens {grain.describe()}: full strength" + pure,
-                            Decision.NEIGHBOURHOOD_HARD_EDGED, prior, edge_scale=SHARPENED_GRAIN_EDGE_SCALE)
+        return PairAnalysis(SHARPENED_GRAIN_BLEND_SPACE, 1.0, why + f" that sharpens {grain.describe()}: full "
+                                                               "strength, blended in linear light" + pure,
+                            Decision.NEIGHBOURHOOD_HARD_EDGED, prior, edge_scale=grain.edge_scale)
     return PairAnalysis(space, 1.0, why + ": full strength" + pure, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
 
 

@@ -34,7 +34,7 @@ from ..colour import LUMA
 from ..spec import to_working_space
 from ..spec.blend_model import edge_strength
 
-__all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN", "FILTERED_GRAIN_SPAN", "GRAIN_EDGE_SCALE", "GRAIN_EDGE_SHARE", "grain_edge_scale", "SHARPENED_GRAIN_EDGE_SCALE",
+__all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN", "FILTERED_GRAIN_SPAN", "GRAIN_EDGE_SCALE", "GRAIN_EDGE_SHARE", "grain_edge_scale", "SHARPENED_GRAIN_BLEND_SPACE",
            "MAX_GRAIN_SPAN", "GRAINED_NEIGHBOURHOOD_STRENGTH"]
 
 #: The pure colours' contrast floor, in multiples of the quiet pixels' 3 x 3 luma span.
@@ -68,15 +68,18 @@ GRAIN_EDGE_SHARE = 1.0
 #: (worst 0.09 dB), 0.5: 0 (worst 0.00 dB); unsharp masks keep full strength (at 0.5 their
 #: gain on notice fell from 0.45-0.52 to 0.21-0.23).
 GRAINED_NEIGHBOURHOOD_STRENGTH = 0.5
-#: ``sigma_e`` is multiplied by this on a coarse grain under a sharpening filter (an unsharp
-#: mask), at full strength: the mask sharpens the grain, the reference keeps it sharpened,
-#: and at the user's sigma_e the repair took it back next to the letters (haze). Tuning
-#: half, memo and notice under the two tuning unsharp masks, PNG and JPEG (16 cases), mean
-#: error reduction / paper pixels darker than F: 1 (the user's) 0.323 / 1408, 2 0.317 / 426,
-#: 3 0.311 / 206, 5 0.301 / 126, 10 (the smoothing filters') 0.282 / 105; at 3 the JPEG
-#: pages gain (0.00-0.07 -> 0.01-0.09) and the PNG notice loses 0.02-0.05, none worse
-#: than F.
-SHARPENED_GRAIN_EDGE_SCALE = 3.0
+#: Under a sharpening filter (an unsharp mask) a coarse grain's page is blended in this
+#: space, at the grain's ``sigma_e`` and full strength. The mask sharpens the grain, and
+#: the reference keeps it sharpened: at the user's sigma_e the repair took it back beside
+#: the letters (haze). The grain also keeps the letters' thin strokes from their pure
+#: colours, and without them the strokes' partial colours blend better in linear light, as
+#: the paper's method does (serif and the star burst under the tuning unsharp masks without
+#: pure colours: sRGB 0.32-0.41, linear 0.50-0.57). Tuning half, memo and notice under the
+#: two tuning unsharp masks (PNG and JPEG, the 11 cases on a coarse grain of 15), mean error
+#: reduction of the 15 / paper pixels darker than F: the chosen space at the user's sigma_e
+#: 0.345 / 1408 px, at 3 times it 0.332 / 206; linear light at 3, 5 and 10 times 0.496 /
+#: 1116, 0.474 / 461, 0.429 / 146 (the paper's method 0.518 / 3946).
+SHARPENED_GRAIN_BLEND_SPACE = "linear"
 #: A quiet span above this is no paper grain but content with no flat pixel: the built-in
 #: suite's dense lines span 67 (linear) and 115 (sRGB) levels there, and with their quiet
 #: span as a grain lost their pure colours (quick suite 0.792 -> 0.693 linear).
