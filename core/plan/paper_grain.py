@@ -23,7 +23,11 @@ pages 38-39 levels). So:
   confidence is ``1 - exp(-(e / sigma_e)^2)`` with ``e`` the product of O's and F's
   gradients: the grain's ``e`` is about 0.01 (O's gradient 0.03-0.05 times what the filter
   makes of it), text's 0.1-0.3, so a larger scale leaves the bare paper as F has it (the
-  haze a repair paints there) and the letters repaired.
+  haze a repair paints there) and the letters repaired; where the filter leaves the letters
+  weak edges too (a solarize), the scale stops at their edge strength
+  (:func:`grain_edge_scale`);
+* a sharpening filter on a coarse grain sharpens the grain too: full strength at the
+  grain's ``sigma_e``, blended in linear light (:data:`SHARPENED_GRAIN_BLEND_SPACE`).
 """
 
 from dataclasses import dataclass
@@ -34,8 +38,9 @@ from ..colour import LUMA
 from ..spec import to_working_space
 from ..spec.blend_model import edge_strength
 
-__all__ = ["PaperGrain", "paper_grain", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN", "FILTERED_GRAIN_SPAN", "GRAIN_EDGE_SCALE", "GRAIN_EDGE_SHARE", "grain_edge_scale", "SHARPENED_GRAIN_BLEND_SPACE",
-           "MAX_GRAIN_SPAN", "GRAINED_NEIGHBOURHOOD_STRENGTH"]
+__all__ = ["PaperGrain", "paper_grain", "grain_edge_scale", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN", "FILTERED_GRAIN_SPAN",
+           "GRAIN_EDGE_SCALE", "GRAIN_EDGE_SHARE", "SHARPENED_GRAIN_BLEND_SPACE", "MAX_GRAIN_SPAN",
+           "GRAINED_NEIGHBOURHOOD_STRENGTH"]
 
 #: The pure colours' contrast floor, in multiples of the quiet pixels' 3 x 3 luma span.
 #: Tuning half, scans under levels, equalization, posterize and thresholds (memo and notice,
