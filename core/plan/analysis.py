@@ -53,7 +53,8 @@ colour lines better), then takes the first of these exits that applies, each nam
     content under a smoothing filter (``hatching``) full strength in its flat regions only
     and a lower one in the hatched ones (the local plan); on a page with a coarse paper
     grain under a smoothing filter (``paper_grain``) half strength at the grain's sigma_e
-    and no pure colours; from a JPEG under a smoothing filter (``compression``), not
+    and no pure colours, under a sharpening one full strength at the grain's sigma_e in
+    linear light; from a JPEG under a smoothing filter (``compression``), not
     hatched, half strength and no pure colours.
 
 In a compressed O, texture is read in the blocks of its grid that hold no edge
