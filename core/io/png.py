@@ -54,7 +54,7 @@ COMPRESSION_LEVEL = 1
 #: :data:`FLAT_LEVEL` (the table above: it is the faster above about 0.6-0.7).
 FLAT_ZERO_SHARE = 0.75
 FLAT_LEVEL = 2
-#: Images up to this many bytes of samples are compressed in one call (libdeflate).
+#: Images up to this many bytes of samples are compressed in one call (libdeflate or zlib-ng).
 ONE_SHOT_BYTES = 1 << 28
 # Rows per band of the banded encoder, and the largest IDAT chunk written.
 _BAND_BYTES = 1 << 24

@@ -459,8 +459,9 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # grain's sigma_e, so that the bare paper keeps it, blended in linear light
     # (SHARPENED_GRAIN_BLEND_SPACE says why).
     if grain.coarse:
+        # The blend space is named by the summary line (a user's --blend-space overrides it).
         return PairAnalysis(SHARPENED_GRAIN_BLEND_SPACE, 1.0, why + f" that sharpens {grain.describe()}: full "
-                                                               "strength, blended in linear light" + pure,
+                                                               "strength at the grain's edge scale" + pure,
                             Decision.NEIGHBOURHOOD_HARD_EDGED, prior, edge_scale=grain.edge_scale)
     return PairAnalysis(space, 1.0, why + ": full strength" + pure, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
 
