@@ -62,7 +62,7 @@ class NumpyBackend:
         gate = None
         prior = plan.pure_colours
         if factor is not None and prior is not None and prior.drawn_only:
-            gate = plan.local.gate(self._encoded, prior.ink_gate)
+            gate = plan.local.gate(self._encoded, prior.ink_gate, prior.ink_span)
         recovered, model = _recover_in_strips(self._original, self._filtered, plan, factor, gate)
         self._result = from_working_space(recovered, self._filtered_rgba, filtered_work=self._filtered,
                                           **self._space)

@@ -34,9 +34,9 @@ import dataclasses
 
 import numpy as np
 
-from ..spec.local_plan import LocalStrength, ink_weight_at
+from ..spec.local_plan import FLAT_SPAN, LocalStrength, ink_weight_at
 
-__all__ = ["drawn_share", "drawn_only", "MIXED_DRAWN_SHARE", "DRAWN_REGION_SHARE"]
+__all__ = ["drawn_share", "drawn_only", "MIXED_DRAWN_SHARE", "DRAWN_REGION_SHARE", "COMPRESSED_INK_SPAN"]
 
 #: The share of a textured window's edge pixels that must read as drawn for its drawn
 #: regions to be repaired under a neighbourhood filter (F kept in the photo): between the
@@ -51,6 +51,24 @@ MIXED_DRAWN_SHARE = 0.1
 #: of the ink), stricter than the gate's own (``INK_GATE_REPEATS``, ``INK_GATE_SHARE_LOW``):
 #: which pairs get the prior did not change when the gate widened.
 DRAWN_REGION_SHARE = 0.01
+
+#: Within what a JPEG original's drawn ink recurs, for the gate of pure colours
+#: (``PureColourPrior.ink_span``; encoded). A JPEG leaves no colour exactly where it was, so
+#: the 8-bit test (:data:`~aarecovery.spec.local_plan.FLAT_SPAN`) found almost no ink on a
+#: compressed image, and the drawings the texture test reads as textured (maps, icons, the
+#: star burst as JPEGs) and the mixed scenes got no pure colours on their thin features. The
+#: prior's own guards against the compression noise (``noise_contrast``, ``ridge_noise``) keep
+#: them off a photo's grain, which at this span reads as ink too (the JPEG photos' windows:
+#: 0.23-0.65 of their edge pixels, 0.00-0.03 at the 8-bit span). Tuning half, JPEG originals
+#: (q 85 and 95) under the 15 point-wise filters, mean edge-band error reduction at 0.5 (the
+#: 8-bit span) / 2.5 / 3.5 / 4.5 levels: maps 0.168 / 0.230 / 0.277 / 0.291, the mixed scenes'
+#: text and graphics 0.244 / 0.296 / 0.325 / 0.338 and photo regions 0.231 / 0.225 / 0.221 /
+#: 0.222 (the least -0.004 / -0.011 / -0.101 / -0.121), the space photo 0.162 / 0.171 / 0.186
+#: / 0.188; the memo page under G'MIC's equalize at q 95 22 / 86 / 132 / 132 paper pixels
+#: darker than F (its amplified grain); from 3.5 the space photo under Pillow's autocontrast
+#: (q 95) lost 0.13-0.14 dB against F. Grey images (no ink gate) and the JPEGs whose grid the
+#: pixels did not show (serif at q 95) did not move.
+COMPRESSED_INK_SPAN = 2.5 / 255
 
 
 def drawn_share(encoded, edges):
@@ -71,7 +89,7 @@ def drawn_share(encoded, edges):
     return LocalStrength(0.0).hard_edged_share(encoded, edges)
 
 
-def drawn_only(prior, encoded, edges, ink=False):
+def drawn_only(prior, encoded, edges, ink=False, ink_span=FLAT_SPAN):
     """`prior` marked to act on the drawn regions only, or None where the window has almost none.
 
     Parameters
@@ -82,11 +100,14 @@ def drawn_only(prior, encoded, edges, ink=False):
     edges : ndarray of bool, shape (H, W)
     ink : bool
         The drawn ink opens the gate too (``PureColourPrior.ink_gate``; colour images).
+    ink_span : float, optional
+        Within what the ink recurs (``PureColourPrior.ink_span``): the 8-bit level, or
+        :data:`COMPRESSED_INK_SPAN` on a JPEG.
 
     Returns
     -------
     PureColourPrior or None
-        With ``drawn_only=True`` (and ``ink_gate=ink``) where at least
+        With ``drawn_only=True`` (and ``ink_gate=ink``, ``ink_span``) where at least
         :data:`DRAWN_REGION_SHARE` of the edge pixels lie where the gate is open (its ink
         read with the strength's stricter test, :data:`DRAWN_REGION_SHARE` says why).
     """
@@ -95,6 +116,7 @@ def drawn_only(prior, encoded, edges, ink=False):
     rows, cols = np.nonzero(edges)
     weight = LocalStrength.region_weight(encoded)[rows, cols]
     if ink:
-        weight = np.maximum(weight, ink_weight_at(encoded, rows, cols))
+        weight = np.maximum(weight, ink_weight_at(encoded, rows, cols, ink_span))
     share = float(np.mean(weight > 0))
-    return dataclasses.replace(prior, drawn_only=True, ink_gate=bool(ink)) if share >= DRAWN_REGION_SHARE else None
+    return (dataclasses.replace(prior, drawn_only=True, ink_gate=bool(ink), ink_span=float(ink_span))
+            if share >= DRAWN_REGION_SHARE else None)

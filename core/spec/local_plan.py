@@ -10,7 +10,8 @@ almost none. Measured on mixed scenes (``aarecovery.lab.mixed_probe``, tuning ha
 edge pixels of the drawn graphics had a median flat share of 0.04-0.10 in the 17 x 17 square
 around them (a tenth of them 0.35-0.39), the photos' edge pixels 0.00-0.02 (99th percentile
 0.07-0.24). A JPEG source has no exactly flat pixels: it reads as a photo everywhere, as the
-whole-image decision reads it.
+whole-image decision reads it; only the gate of pure colours reads its drawn ink within a
+wider span (:func:`ink_weight`'s `span`, ``PureColourPrior.ink_span``).
 
 Per pixel, in passes that read only :data:`REACH` pixels around it, so that a tile with that
 much more halo gives the untiled result (the GL twin, ``backends/gl/shaders/local_plan.glsl``,
@@ -162,7 +163,7 @@ def _smoothstep(t):
     return (t * t * (3 - 2 * t)).astype(np.float32)
 
 
-def ink_weight(encoded, shares=(INK_SHARE_LOW, INK_SHARE_HIGH), repeats=INK_REPEATS):
+def ink_weight(encoded, shares=(INK_SHARE_LOW, INK_SHARE_HIGH), repeats=INK_REPEATS, span=FLAT_SPAN):
     """float32 ``(H, W)``: 1 where the pixel holds drawn ink (a stroke's exactly recurring
     colour), 0 where it holds none, smooth in the pixel's share of the ink.
 
@@ -181,13 +182,16 @@ def ink_weight(encoded, shares=(INK_SHARE_LOW, INK_SHARE_HIGH), repeats=INK_REPE
     repeats : int, optional
         The recurrences an extreme needs: the strength's :data:`INK_REPEATS` or the gate's
         :data:`INK_GATE_REPEATS`.
+    span : float, optional
+        How close a colour must be to the extreme to recur (encoded): :data:`FLAT_SPAN`, the
+        8-bit level, or a JPEG's wider one for the gate (``PureColourPrior.ink_span``).
     """
     planes = np.ascontiguousarray(np.moveaxis(np.asarray(encoded, np.float32), -1, 0))
     extremes = _extremes(planes)
-    return _ink_weight(planes, extremes, _recurrences(planes, extremes), shares, repeats)
+    return _ink_weight(planes, extremes, _recurrences(planes, extremes, span), shares, repeats)
 
 
-def ink_weight_at(encoded, rows, cols):
+def ink_weight_at(encoded, rows, cols, span=FLAT_SPAN):
     """float32 ``(K,)``: :func:`ink_weight` at the pixels ``(rows[k], cols[k])`` only, the
     same values, reading only their neighbourhoods (the summary line reads it at a
     window's edge pixels: 4% of the window on a photo, 5 ms against 90 ms).
@@ -198,6 +202,8 @@ def ink_weight_at(encoded, rows, cols):
         O's sRGB-encoded colour (borders replicated).
     rows, cols : ndarray of int, shape (K,)
         The pixels.
+    span : float, optional
+        As for :func:`ink_weight`.
     """
     encoded = np.asarray(encoded, np.float32)
     rows, cols = np.asarray(rows, np.intp), np.asarray(cols, np.intp)
@@ -215,7 +221,7 @@ def ink_weight_at(encoded, rows, cols):
                 distance = np.abs(colour[0] - ink[0])
                 for channel in (1, 2):
                     np.maximum(distance, np.abs(colour[channel] - ink[channel]), out=distance)
-                same = distance <= np.float32(FLAT_SPAN)
+                same = distance <= np.float32(span)
                 equal += same
                 near += ~same & (distance <= np.float32(INK_NEAR_SPAN))
     return _ink_weight(np.ascontiguousarray(encoded[rows, cols].T), extremes, counts, (INK_SHARE_LOW, INK_SHARE_HIGH),
@@ -263,9 +269,10 @@ def _pick_extremes(colours):
     return brightest, darkest
 
 
-def _recurrences(planes, extremes):
+def _recurrences(planes, extremes, span=FLAT_SPAN):
     """Per extreme: how many pixels of the square of :data:`INK_RADIUS` (inside the image)
-    equal it within :data:`FLAT_SPAN`, and how many lie farther but within :data:`INK_NEAR_SPAN`."""
+    equal it within `span`, and how many lie farther but within :data:`INK_NEAR_SPAN` (none
+    where `span` is as wide)."""
     radius = INK_RADIUS
     height, width = planes.shape[1:]
     # The outside is not there (NaN is equal and near to nothing): replicated borders would
@@ -284,7 +291,7 @@ def _recurrences(planes, extremes):
                     np.subtract(colour[channel], ink[channel], out=difference)
                     np.abs(difference, out=difference)
                     np.maximum(distance, difference, out=distance)
-                same = distance <= np.float32(FLAT_SPAN)
+                same = distance <= np.float32(span)
                 equal += same
                 near += ~same & (distance <= np.float32(INK_NEAR_SPAN))
     return counts
@@ -370,7 +377,7 @@ class LocalStrength:
         return hard_edged_weight(flat_share(encoded))
 
     @staticmethod
-    def gate(encoded, ink):
+    def gate(encoded, ink, ink_span=FLAT_SPAN):
         """float32 ``(H, W)``: where the pure colours of a prior that acts on drawn content only
         act: :meth:`region_weight`, or with `ink` (``PureColourPrior.ink_gate``) the larger of
         it and :func:`ink_weight` at the gate's shares and recurrences (:data:`INK_GATE_SHARE_LOW`,
@@ -381,10 +388,12 @@ class LocalStrength:
         encoded : ndarray of float32, shape (H, W, 3)
             O's sRGB-encoded colour.
         ink : bool
+        ink_span : float, optional
+            Within what the ink recurs (:func:`ink_weight`'s `span`; ``PureColourPrior.ink_span``).
         """
         weight = LocalStrength.region_weight(encoded)
-        return np.maximum(weight, ink_weight(encoded, (INK_GATE_SHARE_LOW, INK_GATE_SHARE_HIGH), INK_GATE_REPEATS)) \
-            if ink else weight
+        return np.maximum(weight, ink_weight(encoded, (INK_GATE_SHARE_LOW, INK_GATE_SHARE_HIGH), INK_GATE_REPEATS,
+                                             ink_span)) if ink else weight
 
     def factor_at(self, encoded, rows, cols):
         """float32 ``(K,)``: :meth:`factor` at the pixels ``(rows[k], cols[k])`` of O only,

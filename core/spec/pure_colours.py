@@ -62,6 +62,7 @@ import numpy as np
 
 from ..colour import LUMA_WEIGHTS, LUMINANCE_D50, REC601_LUMA, linear_to_srgb, srgb_to_linear
 from .blend_model import BlendModel, confidence, coverage, fit_extremes
+from .local_plan import FLAT_SPAN
 from .neighbourhood import NEIGHBOUR_OFFSETS, dot, neighbours, planes
 from .sobel import sobel_magnitude
 
@@ -210,6 +211,10 @@ class PureColourPrior:
         the regions' weight: captions and lines drawn straight on the photo, with no flat
         region around them. Only on colour images (``aarecovery.plan.analysis``): a grey
         photo's levels recur as exactly as ink.
+    ink_span : float
+        With `ink_gate`: how close a colour must be to the ink to recur (encoded; the `span`
+        of ``aarecovery.spec.local_plan.ink_weight``): the 8-bit level, or on a JPEG, whose
+        ink recurs only within its noise, a wider span (``aarecovery.plan.mixed_content``).
     """
 
     key: str
@@ -223,6 +228,7 @@ class PureColourPrior:
     ridge_noise: float = 0.0
     drawn_only: bool = False
     ink_gate: bool = False
+    ink_span: float = FLAT_SPAN
 
     @property
     def min_contrast(self):

@@ -43,7 +43,7 @@ from collections import namedtuple
 import moderngl
 import numpy as np
 
-from ...spec.local_plan import strength_map
+from ...spec.local_plan import FLAT_SPAN, strength_map
 from ...spec.pure_colours import PALETTE_SIZE
 from ...tiling import DEFAULT_TILES
 from ..base import Capabilities, ReadyResult, RecoveryMaps
@@ -405,8 +405,9 @@ class GLBackend:
             defines["PURE_GATE"] = int(local and prior.drawn_only)
         with self._passes():
             if local:
-                self._local_factor(plan.local, None if maps else (lists, active),
-                                   ink_gate=prior is not None and prior.drawn_only and prior.ink_gate)
+                gated = prior is not None and prior.drawn_only and prior.ink_gate
+                self._local_factor(plan.local, None if maps else (lists, active), ink_gate=gated,
+                                   ink_span=prior.ink_span if gated else FLAT_SPAN)
             if maps:
                 self._strength_map(plan)
             if active not in self._working_lists:
@@ -431,7 +432,7 @@ class GLBackend:
         self._stage("passes")
         self._ran = {"maps": maps}
 
-    def _local_factor(self, local, blocks=None, ink_gate=False):
+    def _local_factor(self, local, blocks=None, ink_gate=False, ink_span=FLAT_SPAN):
         """The local plan's factor of beta for the loaded O, once per pair and plan (three passes).
 
         `blocks`: ``(lists, name)``, the block lists of the run, when only the fit reads the
@@ -441,9 +442,10 @@ class GLBackend:
         for bit; the three passes over the whole image took 1.5 s of the 2.2-2.6 s of CPU of
         the tiles of the 4096 x 4096 photo pair (llvmpipe), 0.6 s of 1.25-1.8 s now. None:
         the whole image, as the strength map reads it. `ink_gate`: the second channel (the
-        gate of pure colours on drawn content only) counts the drawn ink too.
+        gate of pure colours on drawn content only) counts the drawn ink too, recurring within
+        `ink_span` (``PureColourPrior.ink_span``).
         """
-        if self._factor_for in ((local, ink_gate, None), (local, ink_gate, blocks and blocks[1])):
+        if self._factor_for in ((local, ink_gate, ink_span, None), (local, ink_gate, ink_span, blocks and blocks[1])):
             return
         defines = {"LOCAL_ENCODE": int(self._linear["original"])}
         steps = (({"original_image": self._textures["original"]}, "local_flat", "dilated"),
@@ -452,10 +454,11 @@ class GLBackend:
                   "strength_factor", "active"))
         for number, (inputs, output, list_name) in enumerate(steps, 1):
             where = {} if blocks is None else {"blocks": blocks[0], "list_name": list_name}
-            uniforms = {"textured": local.textured, "drawn_ink": int(local.drawn_ink), "ink_gate": int(ink_gate)}
+            uniforms = {"textured": local.textured, "drawn_ink": int(local.drawn_ink), "ink_gate": int(ink_gate),
+                        "ink_gate_span": float(ink_span)}
             self._run_pass("local_plan", inputs, [self._work(output)], uniforms=uniforms,
                           defines={**defines, "LOCAL_PASS": number}, **where)
-        self._factor_for = (local, ink_gate, blocks and blocks[1])
+        self._factor_for = (local, ink_gate, ink_span, blocks and blocks[1])
 
     def _strength_map(self, plan):
         """The strength map of the maps: the plan's strength times the local factor (read back)."""

@@ -25,6 +25,7 @@ uniform sampler2D local_input;     // the previous pass's output (passes 2 and 3
 uniform float textured;            // the factor in textured regions (pass 3)
 uniform int drawn_ink;             // 1: drawn ink counts as hard-edged too (pass 3)
 uniform int ink_gate;              // 1: drawn ink opens the gate of pure colours too (pass 3)
+uniform float ink_gate_span;       // within what the gate's ink recurs: FLAT_SPAN, wider on a JPEG (pass 3)
 
 vec3 original_encoded(ivec2 p, ivec2 size) {
     vec3 c = texelFetch(original_image, clamp(p, ivec2(0), size - 1), 0).rgb;
@@ -37,7 +38,8 @@ vec3 original_encoded(ivec2 p, ivec2 size) {
 // 1 where the pixel holds drawn ink: an extreme of its 3 x 3 neighbourhood whose colour
 // recurs exactly in the 7 x 7 square (its part inside the image), with few colours a few
 // levels from it, and not near black; smooth in the pixel's share of that ink, at the
-// strength's shares (.x) and at the gate's (.y).
+// strength's shares (.x) and at the gate's (.y), which counts recurrences within
+// ink_gate_span.
 vec2 ink_weight(ivec2 p, ivec2 size) {
     vec3 brightest = vec3(0.0);
     vec3 darkest = vec3(0.0);
@@ -55,6 +57,8 @@ vec2 ink_weight(ivec2 p, ivec2 size) {
     // One read of the square counts both extremes' repeats (the counts are exact integers).
     ivec2 equal = ivec2(0);
     ivec2 near = ivec2(0);
+    ivec2 gate_equal = ivec2(0);
+    ivec2 gate_near = ivec2(0);
     for (int dy = -INK_RADIUS; dy <= INK_RADIUS; ++dy) {
         for (int dx = -INK_RADIUS; dx <= INK_RADIUS; ++dx) {
             ivec2 q = p + ivec2(dx, dy);
@@ -63,9 +67,13 @@ vec2 ink_weight(ivec2 p, ivec2 size) {
             vec3 d0 = abs(c - brightest);
             vec3 d1 = abs(c - darkest);
             vec2 distance = vec2(max(d0.r, max(d0.g, d0.b)), max(d1.r, max(d1.g, d1.b)));
+            ivec2 is_near = ivec2(lessThanEqual(distance, vec2(INK_NEAR_SPAN)));
             ivec2 is_equal = ivec2(lessThanEqual(distance, vec2(FLAT_SPAN)));
             equal += is_equal;
-            near += (1 - is_equal) * ivec2(lessThanEqual(distance, vec2(INK_NEAR_SPAN)));
+            near += (1 - is_equal) * is_near;
+            ivec2 is_gate_equal = ivec2(lessThanEqual(distance, vec2(ink_gate_span)));
+            gate_equal += is_gate_equal;
+            gate_near += (1 - is_gate_equal) * is_near;
         }
     }
     vec3 centre = original_encoded(p, size);
@@ -73,9 +81,10 @@ vec2 ink_weight(ivec2 p, ivec2 size) {
     for (int side = 0; side < 2; ++side) {
         vec3 ink = side == 0 ? brightest : darkest;
         vec3 other = side == 0 ? darkest : brightest;
-        // The strength's test, then the gate's (fewer recurrences).
-        bool few_near = 2 * near[side] <= equal[side] && max(ink.r, max(ink.g, ink.b)) > INK_DARK;
-        bvec2 drawn = bvec2(few_near && equal[side] >= INK_REPEATS, few_near && equal[side] >= INK_GATE_REPEATS);
+        // The strength's test, then the gate's (fewer recurrences, within its span).
+        bool bright = max(ink.r, max(ink.g, ink.b)) > INK_DARK;
+        bvec2 drawn = bvec2(bright && 2 * near[side] <= equal[side] && equal[side] >= INK_REPEATS,
+                            bright && 2 * gate_near[side] <= gate_equal[side] && gate_equal[side] >= INK_GATE_REPEATS);
         vec3 across = other - ink;
         vec3 from_ink = centre - ink;
         float span = sqrt(across.r * across.r + across.g * across.g + across.b * across.b);
