@@ -53,22 +53,25 @@ MIXED_DRAWN_SHARE = 0.1
 DRAWN_REGION_SHARE = 0.01
 
 #: Within what a JPEG original's drawn ink recurs, for the gate of pure colours
-#: (``PureColourPrior.ink_span``; encoded). A JPEG leaves no colour exactly where it was, so
-#: the 8-bit test (:data:`~aarecovery.spec.local_plan.FLAT_SPAN`) found almost no ink on a
-#: compressed image, and the drawings the texture test reads as textured (maps, icons, the
-#: star burst as JPEGs) and the mixed scenes got no pure colours on their thin features. The
-#: prior's own guards against the compression noise (``noise_contrast``, ``ridge_noise``) keep
-#: them off a photo's grain, which at this span reads as ink too (the JPEG photos' windows:
-#: 0.23-0.65 of their edge pixels, 0.00-0.03 at the 8-bit span). Tuning half, JPEG originals
-#: (q 85 and 95) under the 15 point-wise filters, mean edge-band error reduction at 0.5 (the
-#: 8-bit span) / 2.5 / 3.5 / 4.5 levels: maps 0.168 / 0.230 / 0.277 / 0.291, the mixed scenes'
-#: text and graphics 0.244 / 0.296 / 0.325 / 0.338 and photo regions 0.231 / 0.225 / 0.221 /
-#: 0.222 (the least -0.004 / -0.011 / -0.101 / -0.121), the space photo 0.162 / 0.171 / 0.186
-#: / 0.188; the memo page under G'MIC's equalize at q 95 22 / 86 / 132 / 132 paper pixels
-#: darker than F (its grain, which the filter amplified and the reference keeps: at 2.5, 83% of
-#: those pixels end closer to the reference than F's, 11.5 against 13.5 levels); from 3.5 the space photo under Pillow's autocontrast
-#: (q 95) lost 0.13-0.14 dB against F. Grey images (no ink gate) and the JPEGs whose grid the
-#: pixels did not show (serif at q 95) did not move.
+#: (``PureColourPrior.ink_span``; encoded). A JPEG leaves no colour exactly where it was, so the
+#: 8-bit test (:data:`~aarecovery.spec.local_plan.FLAT_SPAN`) found almost no ink on a
+#: compressed image, and the drawings the texture test reads as textured (maps, icons, the star
+#: burst as JPEGs) and the mixed scenes got no pure colours on their thin features. The prior's
+#: own guards against the compression noise (``noise_contrast``, ``ridge_noise``) keep them off
+#: a photo's grain, which at this span reads as ink too (the JPEG photos' windows: 0.23-0.65 of
+#: their edge pixels, 0.00-0.03 at the 8-bit span). Tuning half, JPEG originals (q 85 and 95)
+#: under the 15 point-wise filters, mean edge-band error reduction at 0.5 (the 8-bit span) / 2.5
+#: / 3.5 / 4.5 levels: maps 0.168 / 0.230 / 0.277 / 0.291, the mixed scenes' text and graphics
+#: 0.244 / 0.296 / 0.325 / 0.338 and photo regions 0.231 / 0.225 / 0.221 / 0.222 (the least
+#: -0.004 / -0.011 / -0.101 / -0.121), the space photo 0.162 / 0.171 / 0.186 / 0.188; the memo
+#: page under G'MIC's equalize at q 95 22 / 86 / 132 / 132 paper pixels darker than F (its
+#: grain, which the filter amplified and the reference keeps: at 2.5, 83% of those pixels end
+#: closer to the reference than F's, 11.5 against 13.5 levels); from 3.5 the space photo under
+#: Pillow's autocontrast (q 95) lost 0.13-0.14 dB against F. At 3.0: maps 0.277, text and
+#: graphics 0.324, but a photo region 0.099 of its error below F (the screenshot under OpenCV's
+#: gamma at q 95, its whole band 0.386 -> 0.441) and the memo's 132 pixels: 2.5 keeps every
+#: region within 0.011 of F. Grey images (no ink gate) and the JPEGs whose grid the pixels did
+#: not show (serif at q 95) did not move.
 COMPRESSED_INK_SPAN = 2.5 / 255
 
 
