@@ -11,6 +11,8 @@ from typing import Protocol
 
 import numpy as np
 
+from ..spec.local_plan import REACH as LOCAL_REACH
+
 __all__ = ["Decision", "Plan", "RecoveryMaps", "Capabilities", "Backend", "ReadyResult"]
 
 
@@ -97,6 +99,10 @@ class Plan:
         Above 0 (a smoothing filter, ``aarecovery.plan.smoothing``), ``beta`` falls to 0 where
         F's pixel is O's: the model's pass multiplies it by a smoothstep of F's change from O
         up to this (working space); 0, the paper's, leaves it as it is.
+    toward_original : bool
+        A smoothing filter (``aarecovery.plan.smoothing``): every Jacobi step moves the edge
+        pixels of the hard-edged regions towards O's own colour by the regions' weight
+        (``aarecovery.spec.blend_model.toward_original``).
     forcing : Forcing or None
         Where the safe default keeps F: whether forcing a repair may help, and why or what
         it risks (``aarecovery.plan.forcing``).
@@ -117,6 +123,7 @@ class Plan:
     decision: Decision = Decision.PAPER
     local: object = None
     untouched_span: float = 0.0
+    toward_original: bool = False
     forcing: object = None
     window: tuple = None
 
@@ -128,8 +135,10 @@ class Plan:
     @property
     def reach(self):
         """int: how far beyond the model's own neighbourhood the plan reads O (the local
-        plan's factor; 0 without one): a tile's extra halo."""
-        return 0 if self.local is None else self.local.reach
+        plan's factor, or its regions' weight towards O; 0 without either): a tile's extra halo."""
+        if self.local is None:
+            return LOCAL_REACH if self.toward_original else 0
+        return self.local.reach
 
 
 @dataclass

@@ -4,7 +4,7 @@ import numpy as np
 
 from ..contract import to_rgba_float
 from ..spec import BlendModel, from_working_space, recover_working, to_working_space
-from ..spec.local_plan import encoded_colour, strength_map
+from ..spec.local_plan import LocalStrength, encoded_colour, strength_map
 from ..tiling import DEFAULT_TILES, halo_for
 from .base import Capabilities, ReadyResult, RecoveryMaps
 
@@ -16,7 +16,7 @@ __all__ = ["NumpyBackend"]
 _STRIP_ROWS = 64
 
 
-def _recover_in_strips(original, filtered, plan, factor, gate):
+def _recover_in_strips(original, filtered, plan, factor, gate, toward=None):
     height = original.shape[0]
     halo = halo_for(plan.iterations)
     recovered = np.empty_like(filtered)
@@ -27,7 +27,8 @@ def _recover_in_strips(original, filtered, plan, factor, gate):
         result, model = recover_working(original[start:stop], filtered[start:stop], plan.sigma_d, plan.sigma_e,
                                         plan.iterations, plan.strength, plan.pure_colours, plan.blend_space,
                                         None if factor is None else factor[start:stop], plan.untouched_span,
-                                        None if gate is None else gate[start:stop])
+                                        None if gate is None else gate[start:stop],
+                                        toward=None if toward is None else toward[start:stop])
         inner = slice(top - start, top - start + bottom - top)
         recovered[top:bottom] = result[inner]
         columns.append([getattr(model, name)[inner] for name in BlendModel.MAP_FIELDS])
@@ -63,7 +64,12 @@ class NumpyBackend:
         prior = plan.pure_colours
         if factor is not None and prior is not None and prior.drawn_only:
             gate = plan.local.gate(self._encoded, prior.ink_gate, prior.ink_span)
-        recovered, model = _recover_in_strips(self._original, self._filtered, plan, factor, gate)
+        # A smoothing filter's drawn edges move towards O by the regions' weight (the gate's,
+        # read even without a local plan).
+        toward = None
+        if plan.toward_original:
+            toward = gate if gate is not None else LocalStrength.region_weight(self._encoded)
+        recovered, model = _recover_in_strips(self._original, self._filtered, plan, factor, gate, toward)
         self._result = from_working_space(recovered, self._filtered_rgba, filtered_work=self._filtered,
                                           **self._space)
         self._model = model

@@ -69,5 +69,6 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
     return Plan(**common, blend_space=blend_space or analysis.blend_space,
                 strength=analysis.strength if asked is None else asked, pure_colours=prior,
                 mode="safe", decision=analysis.decision, local=analysis.local if asked is None else None,
-                untouched_span=analysis.untouched_span if asked is None else 0.0, forcing=analysis.forcing,
+                untouched_span=analysis.untouched_span if asked is None else 0.0,
+                toward_original=analysis.toward_original and asked is None, forcing=analysis.forcing,
                 reason=analysis.reason + ("" if asked is None else f"; strength {asked:g} as asked instead"))

@@ -87,7 +87,7 @@ from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
 from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, SHARPENED_GRAIN_BLEND_SPACE, grain_edge_scale, paper_grain
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import pure_colour_prior
-from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, UNTOUCHED_SPAN, contrast_ratio
+from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, UNTOUCHED_SPAN, contrast_ratio, keeps_flat_colours
 from .texture import is_grey, is_textured
 
 __all__ = ["PairAnalysis", "analyse", "analyse_pair", "analysis_crop"]
@@ -144,6 +144,9 @@ class PairAnalysis:
     untouched_span : float
         Under a smoothing filter (``aarecovery.plan.smoothing``), the change of F from O below
         which an edge pixel gets less confidence (0 where F is O); 0: not applied.
+    toward_original : bool
+        Under a smoothing filter: the hard-edged regions' edge pixels move towards O's
+        (``aarecovery.plan.smoothing``, ``Plan.toward_original``).
     """
 
     blend_space: str
@@ -155,6 +158,7 @@ class PairAnalysis:
     forcing: object = None
     edge_scale: float = 1.0
     untouched_span: float = 0.0
+    toward_original: bool = False
 
 
 def analysis_crop(image):
@@ -374,7 +378,9 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                         f"over it ({drawn:.2f} of the edges): strength {strength:g} there{pure}, F "
                                         "kept in the rest" + (_UNTOUCHED if smoothing else ""),
                                         Decision.NEIGHBOURHOOD_MIXED, prior, local=LocalStrength(0.0),
-                                        untouched_span=UNTOUCHED_SPAN if smoothing else 0.0)
+                                        untouched_span=UNTOUCHED_SPAN if smoothing else 0.0,
+                                        toward_original=smoothing and not compression.compressed
+                                        and keeps_flat_colours(o, f))
             sharpening = contrast_ratio(o, f, edges)
             if grey and sharpening >= SMOOTHED_CONTRAST:
                 return PairAnalysis(space, _GREY_SHARPENED_STRENGTH,
@@ -417,7 +423,10 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # A smoothing filter also leaves some edges as O had them (a bilateral filter's strong
     # edges), and so does the reference: there the confidence falls to 0 (UNTOUCHED_SPAN, in
     # the model's pass).
-    untouched = dict(untouched_span=UNTOUCHED_SPAN if smoothing else 0.0)
+    # ... and where it keeps every flat colour of a clean O (not a JPEG's, whose noise the
+    # filter smoothed away), the drawn regions' edges move towards O (plan/smoothing.py).
+    untouched = dict(untouched_span=UNTOUCHED_SPAN if smoothing else 0.0,
+                     toward_original=smoothing and not compression.compressed and keeps_flat_colours(o, f))
     # On a page with a coarse paper grain (plan/paper_grain.py) it spreads the grain as it
     # spreads a JPEG's noise, so the repair runs at the grain's sigma_e, at a lower strength
     # and without pure colours. Tuning half, notice under the three tuning smoothing filters

@@ -26,7 +26,7 @@ import numpy as np
 from .neighbourhood import dot, neighbours, planes
 from .sobel import sobel_magnitude
 
-__all__ = ["BlendModel", "edge_strength", "fit_paper_model", "principal_direction", "fit_extremes", "coverage",
+__all__ = ["BlendModel", "toward_original", "edge_strength", "fit_paper_model", "principal_direction", "fit_extremes", "coverage",
            "confidence", "untouched_factor", "UNTOUCHED_EXTREMES"]
 
 _EM_ITERATIONS = 3
@@ -51,6 +51,9 @@ SPREAD_TIE_FLOOR = np.float32(1e-6)
 #: without the factor, 0.769 at 0.1, shapes in sRGB 0.879 -> 0.842 at 0.2, all five 0.185
 #: without the bound.
 UNTOUCHED_EXTREMES = 0.1
+#: Towards O (:func:`toward_original`), F may have moved the model's extremes by at most this
+#: (largest channel, working space).
+KEPT_EXTREMES = 0.1
 
 
 @dataclass
@@ -78,6 +81,11 @@ class BlendModel:
     colour_a, colour_b : ndarray of float32, shape (H, W, 4), or None
         The pure colours themselves (working space), where `pure_a` / `pure_b`: what the safe
         plan checks its choice of table on.
+    toward : ndarray of float32, shape (H, W), or None
+        Under a smoothing filter (:func:`toward_original`): the weight ``g`` of O's own colour
+        in every Jacobi step, which `beta` already excludes; None: none.
+    original : ndarray of float32, shape (H, W, 4), or None
+        O in the working space, where `toward` is given.
     """
 
     alpha: np.ndarray
@@ -92,6 +100,8 @@ class BlendModel:
     fixed_b: np.ndarray = None
     colour_a: np.ndarray = None
     colour_b: np.ndarray = None
+    toward: np.ndarray = None
+    original: np.ndarray = None
 
     #: The fields that every model has (the pure-colour ones exist only with a prior).
     MAP_FIELDS = ("alpha", "beta", "index_a", "index_b", "residual", "edge")
@@ -302,3 +312,43 @@ def untouched_factor(original, filtered, index_a, index_b, untouched_span):
     t = np.clip(change / np.float32(untouched_span), 0, 1).astype(np.float32)
     return np.where(moved <= UNTOUCHED_EXTREMES, t * t * (np.float32(3) - np.float32(2) * t),
                     np.float32(1)).astype(np.float32)
+
+
+def toward_original(model, original, filtered, weight, kept_extremes=None):
+    """Move `model`'s edge pixels towards O's own colour by `weight`: a smoothing filter.
+
+    A smoothing filter that keeps O's flat colours (a bilateral or edge-preserving filter on
+    text and drawings) changes nothing but the antialiased edges between them, and its
+    reference (the scene filtered at a higher resolution) keeps the scene's flat areas and
+    hard edges: there the blend of F's colours with O's coverage is O's own pixel, whatever
+    the number of colours the pixel mixes, where the paper's model sees two and is
+    confident only where they fit (``aarecovery.plan.smoothing`` has the measurements).
+    Each Jacobi step becomes ``beta' (alpha R[p_a] + (1 - alpha) R[p_b]) + (1 - beta' - g) F
+    + g O`` with ``beta' = (1 - g) beta``: ``(1 - g)`` times the paper's step plus ``g O``.
+    ``g`` is `weight` (the local plan's regions' weight: flat regions read as drawn) at the
+    pixels with an edge strength above 0 whose extremes F moved by at most `kept_extremes`
+    (largest channel, working space): where F moved them further it changed a colour (a
+    colour replacement, which the smoothing test also reads as smoothing), and O's pixel
+    would bring the old colour back; 0 elsewhere.
+
+    Parameters
+    ----------
+    model : BlendModel
+        Changed in place: `beta`, `toward` and `original`.
+    original, filtered : ndarray of float32, shape (H, W, 4)
+        O and F in the working space.
+    weight : ndarray of float32, shape (H, W)
+        From 0 (F's repair as before) to 1 (O's pixel).
+    kept_extremes : float, optional
+        Default :data:`KEPT_EXTREMES`.
+    """
+    limit = KEPT_EXTREMES if kept_extremes is None else kept_extremes
+    change = np.abs(filtered - original).max(axis=-1)
+    near = np.stack(neighbours(change[None]))[:, 0]
+    moved = np.maximum(np.take_along_axis(near, model.index_a[None].astype(np.intp), 0)[0],
+                       np.take_along_axis(near, model.index_b[None].astype(np.intp), 0)[0])
+    g = np.where((model.edge > 0) & (moved <= limit), weight, np.float32(0)).astype(np.float32)
+    model.beta = ((np.float32(1) - g) * model.beta).astype(np.float32)
+    model.toward = g
+    model.original = original
+    return model

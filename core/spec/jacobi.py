@@ -47,5 +47,11 @@ def jacobi_step(recovered, filtered, model):
         at_b = np.where(model.pure_b[..., None], model.fixed_b, at_b)
     alpha = model.alpha[..., None]
     beta = model.beta[..., None]
+    if model.toward is not None:
+        # A smoothing filter's drawn edges move towards O (blend_model.toward_original).
+        toward = model.toward[..., None]
+        # g (O - F) rather than g O - g F: exactly F where F left O's pixel as it was.
+        return (beta * (alpha * at_a + (1 - alpha) * at_b) + (1 - beta) * filtered
+                + toward * (model.original - filtered)).astype(np.float32)
     return (beta * (alpha * at_a + (1 - alpha) * at_b) + (1 - beta) * filtered).astype(np.float32)
 

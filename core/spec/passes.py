@@ -14,7 +14,7 @@ Each function is one pass, and the GL backend has a shader pass of the same name
 
 import numpy as np
 
-from .blend_model import fit_paper_model, untouched_factor
+from .blend_model import fit_paper_model, toward_original, untouched_factor
 from .jacobi import jacobi_step
 from .pure_colours import fit_pure_colour_model
 from .working_space import from_working_space, to_working_space
@@ -23,7 +23,7 @@ __all__ = ["to_working_space", "fit_blend_model", "jacobi_step", "from_working_s
 
 
 def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=None, blend_space="linear",
-                    factor=None, untouched_span=0.0, gate=None):
+                    factor=None, untouched_span=0.0, gate=None, toward=None):
     """Fit the two-colour blend model at every pixel of O (section 3.1) and its confidence.
 
     The GL pass of this name also writes the first Jacobi iterate, which it can form from
@@ -54,6 +54,10 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
     gate : ndarray of float32, shape (H, W), optional
         Where a `prior` that acts on drawn content only acts, from 0 to 1: the local plan's
         weight of the drawn regions (``LocalStrength.region_weight``).
+    toward : ndarray of float32, shape (H, W), optional
+        A smoothing filter's weight of O's own colour in the Jacobi steps, applied last
+        (:func:`~aarecovery.spec.blend_model.toward_original`; the local plan's regions'
+        weight); None: none.
 
     Returns
     -------
@@ -68,11 +72,13 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
     if untouched_span > 0:
         model.beta = (model.beta * untouched_factor(original, filtered, model.index_a, model.index_b,
                                                     untouched_span)).astype(np.float32)
+    if toward is not None:
+        toward_original(model, original, filtered, toward)
     return model
 
 
 def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1.0, prior=None,
-                    blend_space="linear", factor=None, untouched_span=0.0, gate=None, model=None):
+                    blend_space="linear", factor=None, untouched_span=0.0, gate=None, model=None, toward=None):
     """Fit the model and run the Jacobi iterations on working-space images.
 
     Parameters are those of :func:`fit_blend_model`, `iterations` (0 returns F) and `model`,
@@ -86,7 +92,7 @@ def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1
     """
     if model is None:
         model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, factor,
-                                untouched_span, gate)
+                                untouched_span, gate, toward)
     recovered = filtered
     for _ in range(iterations):
         recovered = jacobi_step(recovered, filtered, model)

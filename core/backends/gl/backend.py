@@ -43,7 +43,7 @@ from collections import namedtuple
 import moderngl
 import numpy as np
 
-from ...spec.local_plan import FLAT_SPAN, strength_map
+from ...spec.local_plan import FLAT_SPAN, LocalStrength, strength_map
 from ...spec.pure_colours import PALETTE_SIZE
 from ...tiling import DEFAULT_TILES
 from ..base import Capabilities, ReadyResult, RecoveryMaps
@@ -58,6 +58,9 @@ __all__ = ["GLBackend", "GLUnavailable", "EngineTexture"]
 EngineTexture = namedtuple("EngineTexture", "texture channel linear")
 
 _CONVERT_NONE, _CONVERT_DECODE, _CONVERT_ENCODE = 0, 1, 2
+# The local plan that only gives a plan without one its regions' weight (towards O): a
+# factor of exactly 1 everywhere.
+_REGIONS_ONLY = LocalStrength(1.0, "none", drawn_ink=False)
 # Where each map lives: (texture key, channel).
 _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("model", 3),
                  "edge_strength": ("edge", 0), "strength": ("strength", 0)}
@@ -395,10 +398,15 @@ class GLBackend:
         if prior is not None:
             sources["transfer_table"] = self._transfer_table(prior)
             uniforms.update(self._pure_colour_uniforms(prior))
-        local = plan.local is not None
+        # Towards O reads the local plan's regions' weight (its factor's second channel); a plan
+        # without a local plan gets one whose factor is exactly 1.
+        local_plan = plan.local if plan.local is not None or not plan.toward_original else _REGIONS_ONLY
+        local = local_plan is not None
         if local:
             sources["strength_factor"] = self._work("strength_factor")
-        defines = {**self._defines, "PURE_COLOURS": int(prior is not None), "LOCAL_STRENGTH": int(local)}
+        defines = {**self._defines, "PURE_COLOURS": int(prior is not None), "LOCAL_STRENGTH": int(local),
+                   "TOWARD_ORIGINAL": int(plan.toward_original),
+                   "JACOBI_CONSTANT": int(prior is not None or plan.toward_original)}
         if prior is not None:
             defines.update(self._pure_colour_defines(prior))
             # Pure colours on drawn content only, gated by the local plan's regions' weight.
@@ -406,7 +414,7 @@ class GLBackend:
         with self._passes():
             if local:
                 gated = prior is not None and prior.drawn_only and prior.ink_gate
-                self._local_factor(plan.local, None if maps else (lists, active), ink_gate=gated,
+                self._local_factor(local_plan, None if maps else (lists, active), ink_gate=gated,
                                    ink_span=prior.ink_span if gated else FLAT_SPAN)
             if maps:
                 self._strength_map(plan)
@@ -494,7 +502,7 @@ class GLBackend:
 
     def _fit_blend_model(self, sources, uniforms, defines, lists, maps):
         """The model and the first Jacobi iterate (and the edge map, the Jacobi steps' constant with pure colours)."""
-        pure = defines["PURE_COLOURS"]
+        pure = defines["JACOBI_CONSTANT"]
         outputs = [self._work("model"), self._work("iterate_a")]
         if maps:
             # Maps are read everywhere; outside the active blocks they show the unfitted model.
@@ -516,7 +524,7 @@ class GLBackend:
         margin of ``blocks.active_mask``), where the step before wrote it.
         """
         inputs = {**sources, "model_map": self._work("model")}
-        if defines["PURE_COLOURS"]:
+        if defines["JACOBI_CONSTANT"]:
             inputs["jacobi_constant_map"] = self._work("jacobi_constant")
         previous = self._work("iterate_a") if iterations > 1 else sources["filtered_work"]
         for step in range(2 if iterations > 1 else 1, iterations + 1):

@@ -21,13 +21,15 @@ const float FAINT = 1e-30;
 const float SPREAD_TIE = 1e-3;        // a start further by less is a tie: the first wins
 const float SPREAD_TIE_FLOOR = 1e-6;
 const float UNTOUCHED_EXTREMES = 0.1;  // F moved the extremes by at most this: untouched_factor applies
+const float KEPT_EXTREMES = 0.1;       // ... and towards O applies (toward_original)
 
 struct BlendFit {
     vec4 model;           // alpha, beta, the extremes' offsets (+ 81, 162: pure colours), residual
     vec4 first_iterate;   // working space
     float edge;           // edge strength e_p
     vec4 jacobi_constant; // with pure colours: (1 - beta) F plus beta's share of the fixed
-                          // pure colours, the part of every Jacobi step that R does not change
+                          // pure colours (towards O: (1 - beta - g) F + g O for (1 - beta) F),
+                          // the part of every Jacobi step that R does not change
 };
 
 // Roweis EM for one component is power iteration on the 4x4 scatter matrix (see the NumPy
@@ -169,14 +171,26 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
         float t = clamp(max(max(moved.r, moved.g), max(moved.b, moved.a)) / untouched_span, 0.0, 1.0);
         beta *= t * t * (3.0 - 2.0 * t);
     }
+#if TOWARD_ORIGINAL
+    // A smoothing filter's drawn edges move towards O by the regions' weight, last
+    // (toward_original in aarecovery/spec/blend_model.py).
+    // Only where F kept the extremes (KEPT_EXTREMES): a colour it changed is not O's.
+    float g = (edge > 0.0 && moved_extremes <= KEPT_EXTREMES) ? texelFetch(strength_factor, p, 0).g : 0.0;
+    beta = (1.0 - g) * beta;
+    vec4 data = (1.0 - beta) * f[0] + g * (c[0] - f[0]);  // exactly F where F is O
+#else
+    vec4 data = (1.0 - beta) * f[0];
+#endif
     fit.model = vec4(alpha, beta, code, residual);
-    fit.first_iterate = beta * (alpha * f_a + (1.0 - alpha) * f_b) + (1.0 - beta) * f[0];
+    fit.first_iterate = beta * (alpha * f_a + (1.0 - alpha) * f_b) + data;
 #if PURE_COLOURS
-    // Exactly F where beta is 0, as jacobi.glsl needs.
+    // Exactly F where beta (and g) are 0, as jacobi.glsl needs.
     vec4 fixed_share = vec4(0.0);
     if (ext_a.extended) fixed_share += alpha * ext_a.filtered;
     if (ext_b.extended) fixed_share += (1.0 - alpha) * ext_b.filtered;
-    fit.jacobi_constant = beta * fixed_share + (1.0 - beta) * f[0];
+    fit.jacobi_constant = beta * fixed_share + data;
+#elif TOWARD_ORIGINAL
+    fit.jacobi_constant = data;
 #endif
     return fit;
 }

@@ -37,7 +37,7 @@ layout(rgba32f, binding = 1) uniform writeonly image2D first_iterate;
 #if MAPS
 layout(r32f, binding = 2) uniform writeonly image2D edge_map;
 #endif
-#if PURE_COLOURS
+#if JACOBI_CONSTANT
 layout(rgba32f, binding = CONSTANT_LOCATION) uniform writeonly image2D jacobi_constant;
 #endif
 
@@ -62,7 +62,7 @@ void main() {
 #if MAPS
     imageStore(edge_map, p, vec4(fit.edge, 0.0, 0.0, 1.0));
 #endif
-#if PURE_COLOURS
+#if JACOBI_CONSTANT
     imageStore(jacobi_constant, p, fit.jacobi_constant);
 #endif
 }

@@ -12,7 +12,7 @@ layout(location = 1) out vec4 first_iterate;
 #if MAPS
 layout(location = 2) out vec4 edge_map;       // edge strength in .r
 #endif
-#if PURE_COLOURS
+#if JACOBI_CONSTANT
 layout(location = CONSTANT_LOCATION) out vec4 jacobi_constant;
 #endif
 
@@ -23,7 +23,7 @@ void main() {
 #if MAPS
     edge_map = vec4(fit.edge, 0.0, 0.0, 1.0);
 #endif
-#if PURE_COLOURS
+#if JACOBI_CONSTANT
     jacobi_constant = fit.jacobi_constant;
 #endif
 }

@@ -3,11 +3,12 @@
 
 uniform sampler2D model_map;
 uniform sampler2D previous_iterate;
-#if PURE_COLOURS
-// (1 - beta) F plus beta's share of the fixed pure colours, written by the fit
-// (blend_model.glsl): what each step adds to the gathers of R. It stands in for F, so the
-// step reads as many texels as the paper's (model, constant, two gathers) instead of
-// fetching both fixed colours at every pixel (llvmpipe fetches both sides of a ?:).
+#if JACOBI_CONSTANT
+// (1 - beta) F plus beta's share of the fixed pure colours (and, towards O, (1 - beta - g) F
+// plus g O), written by the fit (blend_model.glsl): what each step adds to the gathers of R.
+// It stands in for F, so the step reads as many texels as the paper's (model, constant, two
+// gathers) instead of fetching both fixed colours at every pixel (llvmpipe fetches both
+// sides of a ?:).
 uniform sampler2D jacobi_constant_map;
 #endif
 
@@ -15,8 +16,8 @@ vec4 jacobi_step(ivec2 p, ivec2 size) {
     vec4 model = texelFetch(model_map, p, 0);
     float alpha = model.x;
     float beta = model.y;
-#if PURE_COLOURS
-    vec4 recovered = texelFetch(jacobi_constant_map, p, 0);  // exactly F where beta is 0
+#if JACOBI_CONSTANT
+    vec4 recovered = texelFetch(jacobi_constant_map, p, 0);  // exactly F where beta and g are 0
 #else
     vec4 recovered = texelFetch(filtered_work, p, 0);
 #endif
@@ -39,6 +40,8 @@ vec4 jacobi_step(ivec2 p, ivec2 size) {
         float weight_a = (pure == 1.0 || pure == 3.0) ? 0.0 : beta * alpha;
         float weight_b = pure >= 2.0 ? 0.0 : beta * (1.0 - alpha);
         recovered = weight_a * at_a + weight_b * at_b + recovered;
+#elif JACOBI_CONSTANT
+        recovered = beta * (alpha * at_a + (1.0 - alpha) * at_b) + recovered;
 #else
         recovered = beta * (alpha * at_a + (1.0 - alpha) * at_b) + (1.0 - beta) * recovered;
 #endif
