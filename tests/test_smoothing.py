@@ -146,13 +146,13 @@ def test_gl_keeps_f_where_a_smoothing_filter_left_o_as_numpy_does(gl_path):
         assert_results_agree(tiled, numpy_result, backend)
 
 
-def _serif_under(filter_name, space="srgb", width=64):
+def _serif_under(filter_name, space="srgb", width=64, family="serif"):
     import dataclasses
     from aarecovery.lab import realtools
     from test_realtools import require_tool
     require_tool(realtools.TOOL_FILTERS[filter_name].tool)
-    suite = dataclasses.replace(realtools.REAL_FULL, families=("serif",), filters=(filter_name,),
-                                spaces={"serif": (space,)}, width=width)
+    suite = dataclasses.replace(realtools.REAL_FULL, families=(family,), filters=(filter_name,),
+                                spaces={family: (space,)}, width=width)
     (case,) = realtools.build_cases(suite, "tune", jpeg=False)
     return case
 
@@ -160,8 +160,8 @@ def _serif_under(filter_name, space="srgb", width=64):
 def test_a_smoothed_drawing_moves_towards_o_where_the_filter_kept_its_colours():
     """OpenCV's bilateral filter on serif text keeps the flat ink and paper and softens the
     edges between them, and its reference keeps them as O has them: towards O the edge band
-    loses nearly all of F's error (measured 0.95 at 96 px), where the model alone, whose two
-    colours miss the pixels a serif's three-colour corners mix, kept a fifth of it."""
+    loses nearly all of F's error (0.93 at 64 px, 0.95 at 96 px), where the model alone,
+    whose two colours miss the pixels a serif's three-colour corners mix, left 0.23 of it."""
     import dataclasses
     case = _serif_under("cv-bilateral")
     band = edge_band(case.original, case.filtered, case.reference)
@@ -169,11 +169,12 @@ def test_a_smoothed_drawing_moves_towards_o_where_the_filter_kept_its_colours():
         engine.set_images(case.original, case.filtered)
         plan = engine.plan()
         assert plan.toward_original and plan.untouched_span > 0, plan.reason
+        assert "moved towards O" in plan.reason, plan.reason
         engine.run(plan)
         towards = error_reduction(engine.result(), case.filtered, case.reference, band)
         engine.run(dataclasses.replace(plan, toward_original=False))
         without = error_reduction(engine.result(), case.filtered, case.reference, band)
-    assert towards > 0.9 and towards > without + 0.1, (towards, without)
+    assert towards > 0.88 and towards > without + 0.1, (towards, without)
 
 
 def test_towards_o_leaves_a_changed_colour_to_the_model():
@@ -203,22 +204,31 @@ def test_towards_o_leaves_a_changed_colour_to_the_model():
 
 @pytest.mark.gl
 def test_towards_o_is_the_same_on_gl_tiled_and_whole(gl_path):
-    """The regions' weight comes from the local plan's passes also for a plan without a local
-    plan (a factor of exactly 1): GL equals NumPy, whole and in tiles that cut the text."""
+    """The gate comes from the local plan's passes also for a plan without a local plan (a
+    factor of exactly 1): GL equals NumPy, whole and in tiles that cut the text, with the
+    pure colours of thin features and without them (the paper's passes and a Jacobi
+    constant of their own)."""
+    import dataclasses
     case = _serif_under("cv-bilateral", "linear")
     with aarecovery.Engine("numpy") as engine:
         engine.set_images(case.original, case.filtered)
         plan = engine.plan()
-        engine.run(plan, maps=True)
-        expected, expected_maps = engine.result(), engine.maps()
     assert plan.toward_original and plan.local is None and plan.reach > 0, plan.reason
-    with aarecovery.Engine("gl", gl_path=gl_path) as engine:
-        engine.set_images(case.original, case.filtered)
-        engine.run(plan, maps=True)
-        assert_results_agree(engine.result(), expected, gl_path)
-        assert_maps_agree(engine.maps(), expected_maps, message=gl_path)
-    tiled = aarecovery.recover(case.original, case.filtered, backend="gl", gl_path=gl_path, plan=plan, tile_size=64)
-    assert_results_agree(tiled, expected, f"{gl_path} tiled")
+    assert plan.pure_colours is not None, plan.reason
+    for each in (plan, dataclasses.replace(plan, pure_colours=None)):
+        with aarecovery.Engine("numpy") as engine:
+            engine.set_images(case.original, case.filtered)
+            engine.run(each, maps=True)
+            expected, expected_maps = engine.result(), engine.maps()
+        message = f"{gl_path}, pure colours {each.pure_colours is not None}"
+        with aarecovery.Engine("gl", gl_path=gl_path) as engine:
+            engine.set_images(case.original, case.filtered)
+            engine.run(each, maps=True)
+            assert_results_agree(engine.result(), expected, message)
+            assert_maps_agree(engine.maps(), expected_maps, message=message)
+        tiled = aarecovery.recover(case.original, case.filtered, backend="gl", gl_path=gl_path, plan=each,
+                                   tile_size=64)
+        assert_results_agree(tiled, expected, f"{message}, tiled")
 
 
 def test_an_asked_strength_does_not_move_towards_o():
@@ -251,3 +261,36 @@ def test_a_filter_that_moves_a_flat_colour_does_not_move_towards_o():
         engine.set_images(original, filtered)
         plan = engine.plan()
     assert plan.untouched_span > 0 and not plan.toward_original, plan.reason
+
+
+def test_dense_line_work_moves_towards_o_by_its_drawn_ink():
+    """The star burst's spokes leave few flat regions, but their ink recurs exactly: the
+    weight of O is the drawn ink's there too (OpenCV's bilateral in sRGB at 64 px: 0.81,
+    0.55 without moving towards O; at 96 px 0.72 with the regions' weight alone, 0.92 with
+    the ink)."""
+    import dataclasses
+    case = _serif_under("cv-bilateral", family="starburst")
+    band = edge_band(case.original, case.filtered, case.reference)
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        plan = engine.plan()
+        assert plan.toward_original, plan.reason
+        engine.run(plan)
+        towards = error_reduction(engine.result(), case.filtered, case.reference, band)
+        engine.run(dataclasses.replace(plan, toward_original=False))
+        without = error_reduction(engine.result(), case.filtered, case.reference, band)
+    assert towards > 0.75 and towards > without + 0.15, (towards, without)
+
+
+@pytest.mark.parametrize("filter_name", ["colourtogrey", "replacecolour"])
+def test_a_colour_map_read_as_smoothing_does_not_move_towards_o(filter_name):
+    """The built-in colour to grey and colour replacement on thin lines read as smoothing
+    filters (the lines' colours are never flat, so no flat pixel moves): without the
+    flat-colour prior (F on O's colour lines) they keep the model's repair (towards O they
+    fell from 0.56 to 0.34 and from 0.71 to 0.65 of the edge error)."""
+    case = make_case(_scenes.render("lines", 80, 4), filter_name, 4, "srgb")
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        plan = engine.plan()
+    assert plan.untouched_span > 0 and plan.pure_colours is None, plan.reason
+    assert not plan.toward_original, plan.reason

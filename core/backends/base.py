@@ -101,7 +101,8 @@ class Plan:
         up to this (working space); 0, the paper's, leaves it as it is.
     toward_original : bool
         A smoothing filter (``aarecovery.plan.smoothing``): every Jacobi step moves the edge
-        pixels of the hard-edged regions towards O's own colour by the regions' weight
+        pixels of the drawn content towards O's own colour by the local plan's gate (its regions'
+        weight or drawn ink)
         (``aarecovery.spec.blend_model.toward_original``).
     forcing : Forcing or None
         Where the safe default keeps F: whether forcing a repair may help, and why or what
@@ -135,7 +136,7 @@ class Plan:
     @property
     def reach(self):
         """int: how far beyond the model's own neighbourhood the plan reads O (the local
-        plan's factor, or its regions' weight towards O; 0 without either): a tile's extra halo."""
+        plan's factor, or its gate towards O; 0 without either): a tile's extra halo."""
         if self.local is None:
             return LOCAL_REACH if self.toward_original else 0
         return self.local.reach

@@ -64,11 +64,12 @@ class NumpyBackend:
         prior = plan.pure_colours
         if factor is not None and prior is not None and prior.drawn_only:
             gate = plan.local.gate(self._encoded, prior.ink_gate, prior.ink_span)
-        # A smoothing filter's drawn edges move towards O by the regions' weight (the gate's,
-        # read even without a local plan).
+        # A smoothing filter's drawn edges move towards O by the gate of drawn content: the
+        # pure colours' gate where they have one, else the regions' weight or the drawn ink
+        # (read even without a local plan).
         toward = None
         if plan.toward_original:
-            toward = gate if gate is not None else LocalStrength.region_weight(self._encoded)
+            toward = gate if gate is not None else LocalStrength.gate(self._encoded, True)
         recovered, model = _recover_in_strips(self._original, self._filtered, plan, factor, gate, toward)
         self._result = from_working_space(recovered, self._filtered_rgba, filtered_work=self._filtered,
                                           **self._space)

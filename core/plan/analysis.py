@@ -115,6 +115,8 @@ _PHOTO_NEIGHBOURHOOD_STRENGTH = 0.0
 _GREY_SHARPENED_STRENGTH = 0.25
 # The reasons' note of a smoothing filter's untouched edges (plan/smoothing.py).
 _UNTOUCHED = ", F kept where it left O's edges as they were"
+# ... and of the drawn content's edges moved towards O (Plan.toward_original).
+_TOWARD = ", the drawn edges moved towards O"
 
 
 @dataclass(frozen=True)
@@ -367,6 +369,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                     # +0.03 to +0.22), photo regions unchanged; the poster's filters keep no
                     # flat colours there. Every filter's text and graphics 0.387 -> 0.402.
                     prior, kept = flat_colour_prior(o, f, edges)
+                    toward = _moves_towards_original(smoothing, prior, compression, o, f)
                     # Not opened by the drawn ink: there the photo keeps F, and the extension
                     # at ink pixels moved the screenshot's photo regions under an unsharp mask
                     # (built-in filter: 0.017 -> 0.009 of their error; tuning half, the mixed
@@ -376,11 +379,11 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                     return PairAnalysis(space, strength,
                                         f"neighbourhood filter on a textured image ({texture}) with text or drawings "
                                         f"over it ({drawn:.2f} of the edges): strength {strength:g} there{pure}, F "
-                                        "kept in the rest" + (_UNTOUCHED if smoothing else ""),
+                                        "kept in the rest" + (_UNTOUCHED if smoothing else "")
+                                        + (_TOWARD if toward else ""),
                                         Decision.NEIGHBOURHOOD_MIXED, prior, local=LocalStrength(0.0),
                                         untouched_span=UNTOUCHED_SPAN if smoothing else 0.0,
-                                        toward_original=smoothing and not compression.compressed
-                                        and keeps_flat_colours(o, f))
+                                        toward_original=toward)
             sharpening = contrast_ratio(o, f, edges)
             if grey and sharpening >= SMOOTHED_CONTRAST:
                 return PairAnalysis(space, _GREY_SHARPENED_STRENGTH,
@@ -423,10 +426,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # A smoothing filter also leaves some edges as O had them (a bilateral filter's strong
     # edges), and so does the reference: there the confidence falls to 0 (UNTOUCHED_SPAN, in
     # the model's pass).
-    # ... and where it keeps every flat colour of a clean O (not a JPEG's, whose noise the
-    # filter smoothed away), the drawn regions' edges move towards O (plan/smoothing.py).
-    untouched = dict(untouched_span=UNTOUCHED_SPAN if smoothing else 0.0,
-                     toward_original=smoothing and not compression.compressed and keeps_flat_colours(o, f))
+    untouched = dict(untouched_span=UNTOUCHED_SPAN if smoothing else 0.0)
     # On a page with a coarse paper grain (plan/paper_grain.py) it spreads the grain as it
     # spreads a JPEG's noise, so the repair runs at the grain's sigma_e, at a lower strength
     # and without pure colours. Tuning half, notice under the three tuning smoothing filters
@@ -444,6 +444,10 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     prior, kept = flat_colour_prior(o, f, edges)
     pure = f", pure colours of thin features ({kept})" if prior is not None else ""
     why = f"neighbourhood filter on hard-edged content (repair-to-error ratio {ratio:.1f})"
+    # Where it keeps O's colours (the prior: its flat areas and colour lines; every flat pixel)
+    # in a clean O (not a JPEG's, whose noise the filter smoothed away), the drawn content's
+    # edges move towards O (plan/smoothing.py).
+    untouched["toward_original"] = _moves_towards_original(smoothing, prior, compression, o, f)
     # Hatching and screentone are texture to a smoothing filter, not edges to blend
     # (plan/hatching.py): on a hatched O the flat regions are repaired at full strength, the
     # hatched ones at a lower one (the local plan).
@@ -451,7 +455,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     if smoothing and hatched >= HATCHED_SHARE:
         return PairAnalysis(space, 1.0, why + f": full strength in flat regions, {HATCHED_STRENGTH:g} in the "
                                               f"hatching or screentone around {hatched:.2f} of the edges" + pure
-                            + _UNTOUCHED, Decision.NEIGHBOURHOOD_HARD_EDGED, prior,
+                            + _UNTOUCHED + (_TOWARD if untouched["toward_original"] else ""),
+                            Decision.NEIGHBOURHOOD_HARD_EDGED, prior,
                             local=LocalStrength(HATCHED_STRENGTH, "hatching and screentone", drawn_ink=False),
                             **untouched)
     # A JPEG's noise goes through a smoothing filter too, spread over the edges: the repair
@@ -465,7 +470,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # edges: a conversion to grey lowers the luma contrast too (GIMP's desaturate).
     if smoothing and prior is not None:
         return PairAnalysis(space, SMOOTHED_STRENGTH, why + f": a smoothing filter, strength {SMOOTHED_STRENGTH:g}"
-                            + pure + _UNTOUCHED, Decision.NEIGHBOURHOOD_HARD_EDGED, prior, **untouched)
+                            + pure + _UNTOUCHED + (_TOWARD if untouched["toward_original"] else ""),
+                            Decision.NEIGHBOURHOOD_HARD_EDGED, prior, **untouched)
     # A sharpening filter on a coarse grain sharpens the grain too: the passes run at the
     # grain's sigma_e, so that the bare paper keeps it, blended in linear light
     # (SHARPENED_GRAIN_BLEND_SPACE says why).
@@ -475,6 +481,13 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                                                "strength at the grain's edge scale" + pure,
                             Decision.NEIGHBOURHOOD_HARD_EDGED, prior, edge_scale=grain.edge_scale)
     return PairAnalysis(space, 1.0, why + ": full strength" + pure, Decision.NEIGHBOURHOOD_HARD_EDGED, prior)
+
+
+def _moves_towards_original(smoothing, flat_prior, compression, o, f):
+    """Whether a smoothing filter's drawn edges move towards O (``Plan.toward_original``): F
+    keeps O's colours (the flat-colour prior exists and no flat pixel moved by more than
+    ``smoothing.FLAT_COLOUR_MOVE``) and O is not compressed."""
+    return bool(smoothing and flat_prior is not None and not compression.compressed and keeps_flat_colours(o, f))
 
 
 def _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e):

@@ -325,7 +325,8 @@ def toward_original(model, original, filtered, weight, kept_extremes=None):
     confident only where they fit (``aarecovery.plan.smoothing`` has the measurements).
     Each Jacobi step becomes ``beta' (alpha R[p_a] + (1 - alpha) R[p_b]) + (1 - beta' - g) F
     + g O`` with ``beta' = (1 - g) beta``: ``(1 - g)`` times the paper's step plus ``g O``.
-    ``g`` is `weight` (the local plan's regions' weight: flat regions read as drawn) at the
+    ``g`` is `weight` (the local plan's gate of drawn content: flat regions read as drawn, or
+    a stroke's ink recurring exactly nearby; ``LocalStrength.gate``) at the
     pixels with an edge strength above 0 whose extremes F moved by at most `kept_extremes`
     (largest channel, working space): where F moved them further it changed a colour (a
     colour replacement, which the smoothing test also reads as smoothing), and O's pixel

@@ -58,7 +58,7 @@ __all__ = ["GLBackend", "GLUnavailable", "EngineTexture"]
 EngineTexture = namedtuple("EngineTexture", "texture channel linear")
 
 _CONVERT_NONE, _CONVERT_DECODE, _CONVERT_ENCODE = 0, 1, 2
-# The local plan that only gives a plan without one its regions' weight (towards O): a
+# The local plan that only gives a plan without one its gate of drawn content (towards O): a
 # factor of exactly 1 everywhere.
 _REGIONS_ONLY = LocalStrength(1.0, "none", drawn_ink=False)
 # Where each map lives: (texture key, channel).
@@ -398,7 +398,7 @@ class GLBackend:
         if prior is not None:
             sources["transfer_table"] = self._transfer_table(prior)
             uniforms.update(self._pure_colour_uniforms(prior))
-        # Towards O reads the local plan's regions' weight (its factor's second channel); a plan
+        # Towards O reads the local plan's gate (its factor's second channel); a plan
         # without a local plan gets one whose factor is exactly 1.
         local_plan = plan.local if plan.local is not None or not plan.toward_original else _REGIONS_ONLY
         local = local_plan is not None
@@ -413,8 +413,11 @@ class GLBackend:
             defines["PURE_GATE"] = int(local and prior.drawn_only)
         with self._passes():
             if local:
-                gated = prior is not None and prior.drawn_only and prior.ink_gate
-                self._local_factor(local_plan, None if maps else (lists, active), ink_gate=gated,
+                drawn_only = prior is not None and prior.drawn_only
+                gated = drawn_only and prior.ink_gate
+                # Towards O reads the gate too: with the drawn ink where no prior's gate decides.
+                self._local_factor(local_plan, None if maps else (lists, active),
+                                   ink_gate=gated or (plan.toward_original and not drawn_only),
                                    ink_span=prior.ink_span if gated else FLAT_SPAN)
             if maps:
                 self._strength_map(plan)

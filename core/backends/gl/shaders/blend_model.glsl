@@ -172,7 +172,7 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
         beta *= t * t * (3.0 - 2.0 * t);
     }
 #if TOWARD_ORIGINAL
-    // A smoothing filter's drawn edges move towards O by the regions' weight, last
+    // A smoothing filter's drawn edges move towards O by the gate of drawn content, last
     // (toward_original in aarecovery/spec/blend_model.py).
     // Only where F kept the extremes (KEPT_EXTREMES): a colour it changed is not O's.
     float g = (edge > 0.0 && moved_extremes <= KEPT_EXTREMES) ? texelFetch(strength_factor, p, 0).g : 0.0;
