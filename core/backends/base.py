@@ -100,10 +100,9 @@ class Plan:
         F's pixel is O's: the model's pass multiplies it by a smoothstep of F's change from O
         up to this (working space); 0, the paper's, leaves it as it is.
     toward_original : bool
-        A smoothing filter (``aarecovery.plan.smoothing``): every Jacobi step moves the edge
-        pixels of the drawn content towards O's own colour by the local plan's gate (its regions'
-        weight or drawn ink)
-        (``aarecovery.spec.blend_model.toward_original``).
+        A smoothing filter that keeps O's colours (``aarecovery.plan.smoothing``): every Jacobi
+        step moves the edge pixels of the drawn content towards O's own colour by the local
+        plan's gate, its regions' weight or drawn ink (``aarecovery.spec.blend_model.toward_original``).
     forcing : Forcing or None
         Where the safe default keeps F: whether forcing a repair may help, and why or what
         it risks (``aarecovery.plan.forcing``).

@@ -147,8 +147,8 @@ class PairAnalysis:
         Under a smoothing filter (``aarecovery.plan.smoothing``), the change of F from O below
         which an edge pixel gets less confidence (0 where F is O); 0: not applied.
     toward_original : bool
-        Under a smoothing filter: the hard-edged regions' edge pixels move towards O's
-        (``aarecovery.plan.smoothing``, ``Plan.toward_original``).
+        Under a smoothing filter that keeps O's colours: the drawn content's edge pixels move
+        towards O's (``aarecovery.plan.smoothing``, ``Plan.toward_original``).
     """
 
     blend_space: str

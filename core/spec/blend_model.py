@@ -26,8 +26,8 @@ import numpy as np
 from .neighbourhood import dot, neighbours, planes
 from .sobel import sobel_magnitude
 
-__all__ = ["BlendModel", "toward_original", "edge_strength", "fit_paper_model", "principal_direction", "fit_extremes", "coverage",
-           "confidence", "untouched_factor", "UNTOUCHED_EXTREMES"]
+__all__ = ["BlendModel", "edge_strength", "fit_paper_model", "principal_direction", "fit_extremes", "coverage",
+           "confidence", "untouched_factor", "toward_original", "UNTOUCHED_EXTREMES", "KEPT_EXTREMES"]
 
 _EM_ITERATIONS = 3
 _TINY = np.float32(1e-12)
@@ -288,6 +288,14 @@ def fit_paper_model(original, filtered, sigma_d, sigma_e, strength=1.0, only=Non
     return BlendModel(alpha, beta, index_a, index_b, residual, edge)
 
 
+def _moved_extremes(change, index_a, index_b):
+    """float ``(H, W)``: the larger of `change` (F's largest channel change from O) at the two
+    extremes of each pixel's model."""
+    near = np.stack(neighbours(change[None]))[:, 0]
+    return np.maximum(np.take_along_axis(near, index_a[None].astype(np.intp), 0)[0],
+                      np.take_along_axis(near, index_b[None].astype(np.intp), 0)[0])
+
+
 def untouched_factor(original, filtered, index_a, index_b, untouched_span):
     """float32 ``(H, W)``: the factor of ``beta`` where a smoothing filter left O's pixel as it was.
 
@@ -306,15 +314,13 @@ def untouched_factor(original, filtered, index_a, index_b, untouched_span):
         Above 0.
     """
     change = np.abs(filtered - original).max(axis=-1)
-    near = np.stack(neighbours(change[None]))[:, 0]
-    moved = np.maximum(np.take_along_axis(near, index_a[None].astype(np.intp), 0)[0],
-                       np.take_along_axis(near, index_b[None].astype(np.intp), 0)[0])
+    moved = _moved_extremes(change, index_a, index_b)
     t = np.clip(change / np.float32(untouched_span), 0, 1).astype(np.float32)
     return np.where(moved <= UNTOUCHED_EXTREMES, t * t * (np.float32(3) - np.float32(2) * t),
                     np.float32(1)).astype(np.float32)
 
 
-def toward_original(model, original, filtered, weight, kept_extremes=None):
+def toward_original(model, original, filtered, weight):
     """Move `model`'s edge pixels towards O's own colour by `weight`: a smoothing filter.
 
     A smoothing filter that keeps O's flat colours (a bilateral or edge-preserving filter on
@@ -327,8 +333,8 @@ def toward_original(model, original, filtered, weight, kept_extremes=None):
     + g O`` with ``beta' = (1 - g) beta``: ``(1 - g)`` times the paper's step plus ``g O``.
     ``g`` is `weight` (the local plan's gate of drawn content: flat regions read as drawn, or
     a stroke's ink recurring exactly nearby; ``LocalStrength.gate``) at the
-    pixels with an edge strength above 0 whose extremes F moved by at most `kept_extremes`
-    (largest channel, working space): where F moved them further it changed a colour (a
+    pixels with an edge strength above 0 whose extremes F moved by at most
+    :data:`KEPT_EXTREMES` (largest channel, working space): where F moved them further it changed a colour (a
     colour replacement, which the smoothing test also reads as smoothing), and O's pixel
     would bring the old colour back; 0 elsewhere.
 
@@ -340,15 +346,9 @@ def toward_original(model, original, filtered, weight, kept_extremes=None):
         O and F in the working space.
     weight : ndarray of float32, shape (H, W)
         From 0 (F's repair as before) to 1 (O's pixel).
-    kept_extremes : float, optional
-        Default :data:`KEPT_EXTREMES`.
     """
-    limit = KEPT_EXTREMES if kept_extremes is None else kept_extremes
-    change = np.abs(filtered - original).max(axis=-1)
-    near = np.stack(neighbours(change[None]))[:, 0]
-    moved = np.maximum(np.take_along_axis(near, model.index_a[None].astype(np.intp), 0)[0],
-                       np.take_along_axis(near, model.index_b[None].astype(np.intp), 0)[0])
-    g = np.where((model.edge > 0) & (moved <= limit), weight, np.float32(0)).astype(np.float32)
+    moved = _moved_extremes(np.abs(filtered - original).max(axis=-1), model.index_a, model.index_b)
+    g = np.where((model.edge > 0) & (moved <= KEPT_EXTREMES), weight, np.float32(0)).astype(np.float32)
     model.beta = ((np.float32(1) - g) * model.beta).astype(np.float32)
     model.toward = g
     model.original = original

@@ -60,7 +60,7 @@ EngineTexture = namedtuple("EngineTexture", "texture channel linear")
 _CONVERT_NONE, _CONVERT_DECODE, _CONVERT_ENCODE = 0, 1, 2
 # The local plan that only gives a plan without one its gate of drawn content (towards O): a
 # factor of exactly 1 everywhere.
-_REGIONS_ONLY = LocalStrength(1.0, "none", drawn_ink=False)
+_GATE_ONLY = LocalStrength(1.0, "none", drawn_ink=False)
 # Where each map lives: (texture key, channel).
 _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("model", 3),
                  "edge_strength": ("edge", 0), "strength": ("strength", 0)}
@@ -400,7 +400,7 @@ class GLBackend:
             uniforms.update(self._pure_colour_uniforms(prior))
         # Towards O reads the local plan's gate (its factor's second channel); a plan
         # without a local plan gets one whose factor is exactly 1.
-        local_plan = plan.local if plan.local is not None or not plan.toward_original else _REGIONS_ONLY
+        local_plan = plan.local if plan.local is not None or not plan.toward_original else _GATE_ONLY
         local = local_plan is not None
         if local:
             sources["strength_factor"] = self._work("strength_factor")
