@@ -326,6 +326,31 @@ def _block_grain_at(luma, row, column):
     return float((quiet > _BLOCK_GRAIN_RANGE).mean())
 
 
+def _block_spans(luma):
+    """The luma span (max - min) of the 8 x 8 block whose top-left pixel is at each position
+    where one fits, shape ``(H - 7, W - 7)``: every phase's blocks at once, by running extremes
+    over 2, 4 and 8 rows, then columns (the same values as each block's own max - min: 64
+    phases of block copies took 42 ms on a 512 x 512 window, this about 6)."""
+    brightest, darkest = luma, luma
+    for axis in (0, 1):
+        for step in (1, 2, 4):
+            length = brightest.shape[axis] - step
+            ahead = (slice(None),) * axis + (slice(step, None),)
+            here = (slice(None),) * axis + (slice(0, length),)
+            brightest = np.maximum(brightest[here], brightest[ahead])
+            darkest = np.minimum(darkest[here], darkest[ahead])
+    return brightest - darkest
+
+
+def _grain_of_spans(spans):
+    """:func:`_block_grain_at` from the blocks' spans."""
+    spans = spans.reshape(-1)
+    quiet = spans[spans < _BLOCK_EDGE_RANGE]
+    if quiet.size < _MIN_QUIET_BLOCKS:
+        return None
+    return float((quiet > _BLOCK_GRAIN_RANGE).mean())
+
+
 def hidden_compression(encoded):
     """Evidence of a JPEG whose grid the pixels did not show: flat edge-free blocks at some phase.
 
@@ -354,11 +379,11 @@ def hidden_compression(encoded):
         grid path assumes (q 95's); :data:`NO_COMPRESSION` when no phase has
         :data:`BLOCK_GRAIN_SHARE` or fewer grainy edge-free blocks among at least 16.
     """
-    luma = _luma(encoded)
+    spans = _block_spans(_luma(encoded))
     best, phase = None, (0, 0)
     for row in range(BLOCK):
         for column in range(BLOCK):
-            share = _block_grain_at(luma, row, column)
+            share = _grain_of_spans(spans[row::BLOCK, column::BLOCK])
             if share is not None and (best is None or share < best):
                 best, phase = share, (row, column)
     if best is None or best > BLOCK_GRAIN_SHARE:
