@@ -218,12 +218,14 @@ def test_pure_colour_jacobi_steps_agree_on_float_data(gl_engine, iterations):
 
 
 def test_pure_colours_agree_above_a_jpegs_noise(gl_engine):
-    # O's compression noise raises the contrast an extreme needs (a uniform in GL).
+    # O's compression noise raises the contrast an extreme needs, and a colour whose luma is
+    # a flat colour's is that colour (uniforms in GL).
     from jpeg_scans import scan_page, threshold
     _, original, _ = scan_page(7, 75)
     filtered = threshold(original)
     actual = aarecovery.recover(original, filtered, engine=gl_engine)
     assert gl_engine.last_plan.pure_colours.noise_contrast > 30 / 255
+    assert gl_engine.last_plan.pure_colours.luma_purity > 0
     expected = aarecovery.recover(original, filtered, backend="numpy")
     assert np.abs(actual.astype(np.int64) - expected).max() <= 1
 

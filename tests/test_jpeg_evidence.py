@@ -218,3 +218,59 @@ def test_an_unsharp_mask_on_a_jpeg_drawing_is_repaired():
     ratio = repair_to_error_ratio(_rgba(page), _rgba(filtered), linear_input=False, blend_space=analysis.blend_space,
                                   sigma_d=aarecovery.params.SIGMA_D.default, sigma_e=aarecovery.params.SIGMA_E.default)
     assert ratio < COMPRESSED_REPAIR_TO_ERROR
+
+
+def _curve_case(family, space, quality, curve):
+    """A real-tools drawing as a JPEG under an 8-bit curve: O, F, the reference and the band."""
+    from test_safeguards import family_as_jpeg
+
+    from aarecovery.lab.metrics import edge_band
+    from aarecovery.lab.realtools import FAMILIES
+    from aarecovery.plan.resample import box_downsample
+    scene, clean, original = family_as_jpeg(family, 96, quality, space)
+    reference = box_downsample(curve[scene].astype(np.float32) / 255, FAMILIES[family].k, space)
+    band = edge_band(_encoded(clean), _encoded(curve[clean]), reference)
+    return original, curve[original], reference, band
+
+
+def _reduction(original, filtered, reference, band):
+    from aarecovery.lab.metrics import error_reduction
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(original, filtered)
+        plan = engine.plan()
+        recovered = aarecovery.recover(original, filtered, engine=engine)
+    return error_reduction(_encoded(recovered), _encoded(filtered), reference, band), plan
+
+
+_GAMMA = np.rint((np.arange(256) / 255.0) ** 2.2 * 255).astype(np.uint8)
+_LEVELS = np.minimum(255, np.arange(256) * 2).astype(np.uint8)
+
+
+def test_a_jpeg_drawing_without_a_visible_grid_is_a_compressed_drawing_under_a_pointwise_filter(monkeypatch):
+    # The serif page at q 98 under a gamma curve: its flat edge-free blocks make it a drawing
+    # from a JPEG (the calibrated strength, pure colours above the JPEG's noise), where its
+    # ringing made it a photo. Measured: 0.603 of the edge error against 0.517.
+    from aarecovery.plan import analysis
+    case = _curve_case("serif", "srgb", 98, _GAMMA)
+    drawing, plan = _reduction(*case)
+    assert plan.decision == aarecovery.Decision.POINTWISE_HARD_EDGED_COMPRESSED, plan.reason
+    assert plan.pure_colours is not None and plan.pure_colours.luma_purity > 0
+    assert "flat blocks" in plan.reason
+    monkeypatch.setattr(analysis, "hidden_compression", lambda encoded: NO_COMPRESSION)
+    photo, plan = _reduction(*case)
+    assert plan.decision == aarecovery.Decision.POINTWISE_CALIBRATED, plan.reason
+    assert drawing > photo + 0.05
+
+
+def test_a_jpegs_smeared_chroma_is_no_thin_feature(monkeypatch):
+    # The star burst at q 98 under a levels curve: between its dark-blue spokes the tan paper
+    # keeps its luma, but the JPEG's subsampled chroma gives it the spokes' blue; taken for a
+    # thin feature's partial colour, it was extended to a pink that F never had (measured:
+    # -0.151 of the edge error; with the luma purity +0.150).
+    from aarecovery.plan import analysis
+    case = _curve_case("starburst", "srgb", 98, _LEVELS)
+    with_luma, plan = _reduction(*case)
+    assert plan.pure_colours is not None and plan.pure_colours.luma_purity > 0, plan.reason
+    monkeypatch.setattr(analysis, "COMPRESSED_LUMA_PURITY", 0.0)
+    without, _ = _reduction(*case)
+    assert with_luma > 0.1 > 0 > without

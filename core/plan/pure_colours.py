@@ -18,12 +18,23 @@ from ..spec.pure_colours import (EXTENSION_KEYS, PALETTE_SIZE, SHIFT_KEYS, PureC
 from .pointwise import POINTWISE_SHARE, TABLE_KEYS, filled_bins, key_of
 
 __all__ = ["palette_of", "is_monotone", "extrapolate_table", "pure_colour_prior", "affine_in_key_miss",
-           "STRAIGHT_TABLE_MISS"]
+           "STRAIGHT_TABLE_MISS", "COMPRESSED_LUMA_PURITY"]
 
 # A flat pixel's 3x3 neighbourhood lies within this of its colour (encoded values), and a
 # palette colour needs this many flat pixels.
 _FLAT_TOLERANCE = 1.0 / 255
 _PALETTE_MIN_COUNT = 4
+
+#: On a JPEG-compressed O, an extreme whose luma lies within this of a flat colour's
+#: (working space) is that colour (``PureColourPrior.luma_purity``): a JPEG keeps luma at full
+#: resolution and quantises chroma coarsely, at half resolution with 4:2:0 sampling, so the
+#: paper in a gap between two strokes keeps its luma and takes on the strokes' chroma; extended
+#: as a thin feature it turned pink under a levels curve (the star burst at q 98: the tan
+#: paper between its dark-blue spokes, luma 181 against the paper's 182, blue 163 against 132).
+#: Tuning half, the JPEG twins under the 15 point-wise tools, with the flat-blocks reading
+#: (``aarecovery.plan.analysis``): serif 0.309 -> 0.336 of the edge error, the star burst
+#: 0.165 -> 0.209, no new loss; 0.01-0.03 compared in docs/safe-default.md.
+COMPRESSED_LUMA_PURITY = 0.03
 
 # A table counts as monotone when no output channel reverses by more than this (encoded).
 _MONOTONE_TOLERANCE = 2.0 / 255
@@ -186,7 +197,7 @@ def affine_in_key_miss(original, filtered, edges, key):
 
 
 def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None, noise_contrast=0.0,
-                      extend_ends=True, ridge_noise=0.0):
+                      extend_ends=True, ridge_noise=0.0, luma_purity=0.0):
     """The prior for the passes, from the first fitted table fit for the extension.
 
     Keys often tie (a threshold of black/white text matches per channel and by luma); the
@@ -213,6 +224,9 @@ def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None
     ridge_noise : float, optional
         O's compression noise as a contrast, which a thin feature's ridge must also stand out
         from (``PureColourPrior.ridge_noise``); 0 for an uncompressed O.
+    luma_purity : float, optional
+        ``PureColourPrior.luma_purity``: :data:`COMPRESSED_LUMA_PURITY` for a JPEG-compressed
+        O, 0 otherwise.
 
     Returns
     -------
@@ -236,7 +250,7 @@ def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None
     if not fit:
         return None
     priors = [PureColourPrior(candidate.key, palette=palette, noise_contrast=float(noise_contrast),
-                              ridge_noise=float(ridge_noise),
+                              ridge_noise=float(ridge_noise), luma_purity=float(luma_purity),
                               **_extrapolated(original, candidate, extend_ends))
               for candidate in fit
               if candidate.consistency >= fit[0].consistency and candidate.mean_miss <= fit[0].mean_miss + _TIE_MISS]

@@ -13,7 +13,9 @@ filtered directly:
   on the line and both are less extreme than q by more than a tenth of the line's span.
 * It is **not** a partial colour when it is one of the image's flat colours (the
   **palette**: colours of pixels whose whole 3x3 neighbourhood is equal, the 32 most
-  frequent), or when q lies on the image border (a feature cut by the border looks thin).
+  frequent; on a JPEG also a colour with a flat colour's luma, whose chroma the JPEG smeared:
+  :func:`is_flat_colour`), or when q lies on the image border (a feature cut by the border
+  looks thin).
 * Nor when q is O's darkest or brightest colour (every key within 1/255 of an end of O's key
   range) and the other extreme is neither O's opposite end nor a flat colour: the dark paper
   between 0.5 px white lines has no flat pixel, but it is pure; extended to black it turned
@@ -66,8 +68,8 @@ from .local_plan import FLAT_SPAN
 from .neighbourhood import NEIGHBOUR_OFFSETS, dot, neighbours, planes
 from .sobel import sobel_magnitude
 
-__all__ = ["PureColourPrior", "PALETTE_SIZE", "ON_LINE_TOLERANCE", "KEPT_CONTRAST", "EXTENSION_KEYS", "SCALE_KEYS",
-           "SHIFT_KEYS", "filtered_colour", "extend_extreme", "scale_transfer", "key_values", "shift_grey",
+__all__ = ["PureColourPrior", "is_flat_colour", "PALETTE_SIZE", "ON_LINE_TOLERANCE", "KEPT_CONTRAST", "EXTENSION_KEYS",
+           "SCALE_KEYS", "SHIFT_KEYS", "filtered_colour", "extend_extreme", "scale_transfer", "key_values", "shift_grey",
            "fit_pure_colour_model"]
 
 #: Most palette colours kept (a uniform array in the GL pass).
@@ -215,6 +217,13 @@ class PureColourPrior:
         With `ink_gate`: how close a colour must be to the ink to recur (encoded; the `span`
         of ``aarecovery.spec.local_plan.ink_weight``): the 8-bit level, or on a JPEG, whose
         ink recurs only within its noise, a wider span (``aarecovery.plan.mixed_content``).
+    luma_purity : float
+        An extreme whose luma lies within this of a flat colour's (working space, Rec. 709
+        weights on the premultiplied colours) is that flat colour too (:func:`is_flat_colour`):
+        a JPEG keeps luma at full resolution and quantises chroma more coarsely, often at
+        half resolution, so the paper in a gap between two strokes keeps its luma while its
+        chroma takes on the strokes' (``aarecovery.plan.pure_colours`` has the figures).
+        0: colours only (O is not compressed).
     """
 
     key: str
@@ -229,6 +238,7 @@ class PureColourPrior:
     drawn_only: bool = False
     ink_gate: bool = False
     ink_span: float = FLAT_SPAN
+    luma_purity: float = 0.0
 
     @property
     def min_contrast(self):
@@ -384,6 +394,29 @@ RANGE_TOLERANCE = 0.05
 END_TOLERANCE = 1.0 / 255
 
 
+def is_flat_colour(colour, palette, prior):
+    """bool ``(N,)``: `colour` is one of O's flat colours: within :data:`PALETTE_TOLERANCE` of a
+    palette colour, or with the prior's `luma_purity`, its luma within that of one's.
+
+    Parameters
+    ----------
+    colour : ndarray of float32, shape (4, N)
+        Premultiplied working-space colours.
+    palette : ndarray of float32, shape (P, 3)
+        Opaque working-space flat colours.
+    prior : PureColourPrior
+    """
+    flat = np.zeros(colour.shape[1:], bool)
+    luma = np.float32(prior.luma_purity)
+    for entry in palette:
+        miss = colour[:3] - entry[:, None] * colour[3]
+        flat |= miss[0] * miss[0] + miss[1] * miss[1] + miss[2] * miss[2] \
+            < np.float32(PALETTE_TOLERANCE * PALETTE_TOLERANCE)
+        if luma > 0:
+            flat |= np.abs(miss[0] * LUMA_WEIGHTS[0] + miss[1] * LUMA_WEIGHTS[1] + miss[2] * LUMA_WEIGHTS[2]) < luma
+    return flat
+
+
 def extend_extreme(far, near, around, filtered_far, on_border, palette, prior, blend_space, gate=None):
     """Decide whether an extreme colour is a thin feature's partial colour, and extend it.
 
@@ -433,11 +466,7 @@ def extend_extreme(far, near, around, filtered_far, on_border, palette, prior, b
         on_line = (dot(first, first) - t_first * t_first < reach_sq) & \
             (dot(second, second) - t_second * t_second < reach_sq)
         ridge |= on_line & (t_first < limit) & (t_second < limit)
-    candidate = defined & ridge & ~on_border
-    for colour in palette:
-        miss = far[:3] - colour[:, None] * far[3]
-        candidate &= miss[0] * miss[0] + miss[1] * miss[1] + miss[2] * miss[2] \
-            >= np.float32(PALETTE_TOLERANCE * PALETTE_TOLERANCE)
+    candidate = defined & ridge & ~on_border & ~is_flat_colour(far, palette, prior)
     # A fitted table must explain F at the observed extreme. Without one, F there must lie on
     # O's colour line (sharpening moves a thin feature along it; a hue change moves it off,
     # and the identity table would undo the change) and keep the feature's contrast (an
@@ -497,11 +526,7 @@ def extend_extreme(far, near, around, filtered_far, on_border, palette, prior, b
         # and f(white) (lines/sRGB: equalize 0.40, posterize 0.43, gamma 0.61).
         end = np.float32(END_TOLERANCE)
         near_keys = key_values(_encoded_of(near, blend_space), prior.key)
-        near_pure = np.zeros(length.shape, bool)
-        for colour in palette:
-            miss = near[:3] - colour[:, None] * near[3]
-            near_pure |= miss[0] * miss[0] + miss[1] * miss[1] + miss[2] * miss[2] \
-                < np.float32(PALETTE_TOLERANCE * PALETTE_TOLERANCE)
+        near_pure = is_flat_colour(near, palette, prior)
         far_low = (far_keys <= low[:, None] + end).all(axis=0)
         far_high = (far_keys >= high[:, None] - end).all(axis=0)
         near_low = (near_keys <= low[:, None] + end).all(axis=0)

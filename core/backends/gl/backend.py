@@ -501,7 +501,8 @@ class GLBackend:
         low, high = prior.key_range()
         return dict(palette_size=len(colours), palette=[tuple(map(float, colour)) for colour in palette],
                     key_low=tuple(map(float, low)), key_high=tuple(map(float, high)),
-                    noise_contrast=float(prior.noise_contrast), ridge_noise=float(prior.ridge_noise))
+                    noise_contrast=float(prior.noise_contrast), ridge_noise=float(prior.ridge_noise),
+                    luma_purity=float(prior.luma_purity))
 
     def _fit_blend_model(self, sources, uniforms, defines, lists, maps):
         """The model and the first Jacobi iterate (and the edge map, the Jacobi steps' constant with pure colours)."""

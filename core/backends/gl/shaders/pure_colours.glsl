@@ -9,6 +9,8 @@ uniform vec3 key_low;              // O's key range (bin centres of the table's 
 uniform vec3 key_high;             // filled bins, per column); beyond it the table is extrapolated
 uniform float noise_contrast;      // O's compression noise as a contrast (0: not compressed)
 uniform float ridge_noise;         // the same, for the ridge test (0: not compressed; no grain)
+uniform float luma_purity;         // an extreme whose luma is within this of a flat colour's is
+                                   // that colour (0: colours only; is_flat_colour)
 // PURE_GATE: 1: the prior acts on drawn content only, `gate` (the local plan's region
 //            weight, 0 to 1) of the way (PureColourPrior.drawn_only)
 #ifndef PURE_GATE
@@ -208,13 +210,16 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
     // One loop over the palette for both extremes (a loop costs its full length on llvmpipe,
     // whatever its early exits).
     bool far_pure = false, near_pure = false;
+    // The luma test is false for every colour where luma_purity is 0 (an uncompressed O).
     for (int i = 0; i < palette_size; ++i) {
         vec3 miss = far.rgb - palette[i] * far.a;
-        far_pure = far_pure || !(miss.r * miss.r + miss.g * miss.g + miss.b * miss.b >= tolerance_sq);
+        far_pure = far_pure || !(miss.r * miss.r + miss.g * miss.g + miss.b * miss.b >= tolerance_sq)
+                   || abs(miss.r * LUMA.r + miss.g * LUMA.g + miss.b * LUMA.b) < luma_purity;
 #if CLAMP_ENDS
         vec3 near_miss = near.rgb - palette[i] * near.a;
         near_pure = near_pure || near_miss.r * near_miss.r + near_miss.g * near_miss.g
-                                 + near_miss.b * near_miss.b < tolerance_sq;
+                                 + near_miss.b * near_miss.b < tolerance_sq
+                    || abs(near_miss.r * LUMA.r + near_miss.g * LUMA.g + near_miss.b * LUMA.b) < luma_purity;
 #endif
     }
     if (far_pure) return result;
