@@ -250,11 +250,12 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # reads as grain; its edge-free blocks are flat at some phase (compression.hidden_compression),
     # a photo's are not. It is a compressed drawing: the calibrated strength and pure colours
     # above the noise of q 95's table, as where the grid was seen. Tuning half, the JPEG twins
-    # under the 15 point-wise tools (96 px, both spaces): serif at q 95 / 98 0.28-0.30 -> 0.43-0.44
-    # of the edge error, the star burst at q 98 0.22 -> 0.30, no loss against F; at full strength
-    # (as a lossless drawing) serif reached 0.48-0.49 but the star burst in sRGB under GEGL's
-    # levels at q 98 lost 0.32 dB, and without COMPRESSED_LUMA_PURITY the star burst's tan paper
-    # was extended to pink (up to 2.6 dB below F).
+    # under the 15 point-wise tools (96 px, both spaces), at q 98: serif 0.296 -> 0.438 of the
+    # edge error, the star burst 0.218 -> 0.301, no loss against F (the suite's JPEG twins: serif
+    # 0.309 -> 0.336, the star burst 0.165 -> 0.209); at full strength (as a lossless drawing)
+    # serif reached 0.494 at q 98 but the star burst in sRGB under GEGL's levels at q 98 lost
+    # 0.32 dB, and without COMPRESSED_LUMA_PURITY the star burst's tan paper was extended to
+    # pink (up to 2.6 dB below F).
     if textured and transfer.consistency >= POINTWISE_SHARE and not compression.compressed:
         hidden = hidden_compression(o)
         if hidden.compressed:
