@@ -458,7 +458,7 @@ class GLBackend:
         """
         if self._factor_for in ((local, ink_gate, ink_span, None), (local, ink_gate, ink_span, blocks and blocks[1])):
             return
-        defines = {"LOCAL_ENCODE": int(self._linear["original"])}
+        defines = {"LOCAL_ENCODE": int(self._linear["original"]), "INK_BY_LUMA": int(ink_gate and ink_span > FLAT_SPAN)}
         steps = (({"original_image": self._textures["original"]}, "local_flat", "dilated"),
                  ({"local_input": self._work("local_flat")}, "local_rows", "dilated"),
                  ({"local_input": self._work("local_rows"), "original_image": self._textures["original"]},

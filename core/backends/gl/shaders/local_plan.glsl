@@ -19,6 +19,9 @@ const float INK_SHARE_HIGH = 0.7;
 const float INK_GATE_SHARE_LOW = 0.0;
 const float INK_GATE_SHARE_HIGH = 0.3;
 const int INK_GATE_REPEATS = 2;
+const float INK_LUMA_SATURATION = 90.5 / 255.0;
+const float INK_LUMA_DARK = 31.5 / 255.0;
+const float LUMA_TIE = 0.00005 / 255.0;
 
 uniform sampler2D original_image;  // O as uploaded (passes 1 and 3)
 uniform sampler2D local_input;     // the previous pass's output (passes 2 and 3)
@@ -39,7 +42,10 @@ vec3 original_encoded(ivec2 p, ivec2 size) {
 // recurs exactly in the 7 x 7 square (its part inside the image), with few colours a few
 // levels from it, and not near black; smooth in the pixel's share of that ink, at the
 // strength's shares (.x) and at the gate's (.y), which counts recurrences within
-// ink_gate_span.
+// ink_gate_span: with INK_BY_LUMA (the span wider than FLAT_SPAN: a JPEG) by luma for ink
+// neither saturated nor dark (local_plan.py: INK_LUMA_SATURATION). A define, not a test of
+// the span: llvmpipe ran the luma arithmetic for every texel, and pass 3 took 1.5 times as
+// long on a PNG photo.
 vec2 ink_weight(ivec2 p, ivec2 size) {
     vec3 brightest = vec3(0.0);
     vec3 darkest = vec3(0.0);
@@ -54,6 +60,13 @@ vec2 ink_weight(ivec2 p, ivec2 size) {
             if (b < low - INK_TIE) { low = b; darkest = c; }
         }
     }
+#if INK_BY_LUMA
+    vec2 top = vec2(max(brightest.r, max(brightest.g, brightest.b)), max(darkest.r, max(darkest.g, darkest.b)));
+    vec2 bottom = vec2(min(brightest.r, min(brightest.g, brightest.b)), min(darkest.r, min(darkest.g, darkest.b)));
+    bvec2 by_luma = bvec2(top.x - bottom.x <= INK_LUMA_SATURATION && top.x >= INK_LUMA_DARK,
+                          top.y - bottom.y <= INK_LUMA_SATURATION && top.y >= INK_LUMA_DARK);
+    vec2 ink_luma = vec2(dot(brightest, LUMA), dot(darkest, LUMA));
+#endif
     // One read of the square counts both extremes' repeats (the counts are exact integers).
     ivec2 equal = ivec2(0);
     ivec2 near = ivec2(0);
@@ -71,9 +84,14 @@ vec2 ink_weight(ivec2 p, ivec2 size) {
             ivec2 is_equal = ivec2(lessThanEqual(distance, vec2(FLAT_SPAN)));
             equal += is_equal;
             near += (1 - is_equal) * is_near;
-            ivec2 is_gate_equal = ivec2(lessThanEqual(distance, vec2(ink_gate_span)));
+#if INK_BY_LUMA
+            vec2 gate_distance = mix(distance, abs(vec2(dot(c, LUMA)) - ink_luma) - LUMA_TIE, by_luma);
+#else
+            vec2 gate_distance = distance;
+#endif
+            ivec2 is_gate_equal = ivec2(lessThanEqual(gate_distance, vec2(ink_gate_span)));
             gate_equal += is_gate_equal;
-            gate_near += (1 - is_gate_equal) * is_near;
+            gate_near += (1 - is_gate_equal) * ivec2(lessThanEqual(gate_distance, vec2(INK_NEAR_SPAN)));
         }
     }
     vec3 centre = original_encoded(p, size);
