@@ -49,7 +49,10 @@ BLOCK_GRAIN_SHARE = 0.15
 _BLOCK_GRAIN_RANGE = 2.5
 # A block spanning more than this holds an edge (and its ringing): it says nothing of grain.
 _BLOCK_EDGE_RANGE = 24.0
-# Fewer edge-free blocks than this leave the grain undecided (dense line art).
+# Fewer edge-free blocks than this leave the grain undecided (dense line art). Reading 4-15
+# blocks (a share of at most 0.5 grainy makes a drawing) turned the maps into compressed
+# drawings and lost on the tuning half (maps' JPEG twins 0.247 -> 0.235: the textured reading's
+# local plan and ink gate serve them better; Pillow's YCbCr equalize -0.22).
 _MIN_QUIET_BLOCKS = 16
 #: The repair-to-error ratio (``aarecovery.plan.model_error``) a smoothing filter
 #: (``aarecovery.plan.smoothing``) on compressed hard-edged content needs before it is
