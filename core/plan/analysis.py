@@ -399,6 +399,14 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                     # (built-in filter: 0.017 -> 0.009 of their error; tuning half, the mixed
                     # scenes' neighbourhood cases -0.006 to +0.011, no gain).
                     prior = drawn_only(prior, o, edges)
+                    # The strength's ink test leaves the photo's side of a stroke's edge (under
+                    # 0.3 of the ink) at the photo's 0, so half of each edge keeps F's blend.
+                    # Counting it from 0.1 of the ink: tuning half, the mixed scenes under the
+                    # five neighbourhood filters, text and graphics 0.350 -> 0.406, photo regions
+                    # 0.006 -> 0.009 (the poster's least -0.009 -> -0.016); held out, text 0.365 ->
+                    # 0.371 but photo regions worse than F 3 -> 5 and the banner under
+                    # ImageMagick's saturation boost (read as a smoothing filter) 0.16 dB below
+                    # F: the photo's own pixels beside a stroke read as part ink. Not taken.
                     pure = f", pure colours of thin features there ({kept})" if prior is not None else ""
                     return PairAnalysis(space, strength,
                                         f"neighbourhood filter on a textured image ({texture}) with text or drawings "
