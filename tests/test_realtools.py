@@ -69,6 +69,25 @@ def test_runner_gives_what_the_tool_gives(name, arguments, tmp_path):
     np.testing.assert_allclose(batch[1], _direct(tool, arguments, other, tmp_path), atol=1e-6)
 
 
+def test_imagemagick_batches_larger_than_its_pixel_cache_run_in_pieces(monkeypatch):
+    """A batch over the pixels one command line may hold (Debian's policy caps ImageMagick's
+    pixel cache) runs in consecutive pieces and gives what each image alone gives."""
+    from aarecovery.lab import tools
+
+    tool = require_tool("imagemagick")
+    image = _ramp()
+    images = [image, np.ascontiguousarray(image[:, ::-1]), np.ascontiguousarray(image[::-1]), image[:5]]
+    pixels = image.shape[0] * image.shape[1]
+    chunks = tools._imagemagick_chunks(images, 2 * pixels)
+    assert [list(chunk) for chunk in chunks] == [[0, 1], [2, 3]]
+    assert [list(chunk) for chunk in tools._imagemagick_chunks(images, pixels // 2)] == [[0], [1], [2], [3]]
+    monkeypatch.setattr(tools, "_IMAGEMAGICK_PIXELS", 2 * pixels)
+    batch = tool.run(["-threshold", "50%"], images)
+    assert len(batch) == len(images)
+    for result, source in zip(batch, images):
+        np.testing.assert_array_equal(result, tool.run(["-threshold", "50%"], [source])[0])
+
+
 @pytest.mark.parametrize("name", ["gegl", "gmic", "imagemagick"])
 def test_identity_command_returns_the_input(name):
     tool = require_tool(name)

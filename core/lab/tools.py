@@ -132,15 +132,40 @@ def _gmic_batch(executable, arguments, images, folder, support, whole_image):
     return [read_float_rgb(os.path.join(folder, f"out_{i:06d}.tif"), full_scale=255) for i in range(len(images))]
 
 
+# Pixels per ImageMagick command line. Its whole list of images is held at once, and
+# Debian's policy (/etc/ImageMagick-6/policy.xml) caps the pixel cache at 256 MiB of memory,
+# 512 MiB mapped and 1 GiB on disk, limits that -limit cannot raise: 24 references of a 768 px
+# drawing (3072 x 3072 each, 16-bit RGBA) failed with "cache resources exhausted". 32
+# megapixels (256 MiB) leave room for the operation's own copy.
+_IMAGEMAGICK_PIXELS = 32_000_000
+
+
+def _imagemagick_chunks(images, limit):
+    """Consecutive index ranges of `images` whose pixels add up to at most `limit` (one image
+    larger than it on its own)."""
+    chunks, start, pixels = [], 0, 0
+    for index, image in enumerate(images):
+        size = image.shape[0] * image.shape[1]
+        if index > start and pixels + size > limit:
+            chunks.append(range(start, index))
+            start, pixels = index, 0
+        pixels += size
+    return chunks + [range(start, len(images))] if images else chunks
+
+
 def _imagemagick_batch(executable, arguments, images, folder, support, whole_image):
     sources = [os.path.join(folder, f"in{i:05d}.png") for i in range(len(images))]
     for source, image in zip(sources, images):
         write_png8(source, image)
-    # PNG48: 16-bit RGB whatever the result's colour type (a threshold's result would
-    # otherwise be written as a 1-bit grey file).
-    run_command([executable, *sources, *arguments, "+adjoin", "-depth", "16",
-                 "PNG48:" + os.path.join(folder, "out_%05d.png")], timeout=600)
-    return [read_float_rgb(os.path.join(folder, f"out_{i:05d}.png")) for i in range(len(images))]
+    results = []
+    for chunk in _imagemagick_chunks(images, _IMAGEMAGICK_PIXELS):
+        # PNG48: 16-bit RGB whatever the result's colour type (a threshold's result would
+        # otherwise be written as a 1-bit grey file). Each image is processed on its own, so
+        # a command line per chunk gives what one for the whole batch would.
+        run_command([executable, *(sources[i] for i in chunk), *arguments, "+adjoin", "-depth", "16",
+                     "PNG48:" + os.path.join(folder, f"out{chunk.start:05d}_%05d.png")], timeout=600)
+        results += [read_float_rgb(os.path.join(folder, f"out{chunk.start:05d}_{i:05d}.png")) for i in range(len(chunk))]
+    return results
 
 
 @functools.lru_cache(maxsize=None)
