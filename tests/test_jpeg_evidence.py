@@ -200,6 +200,38 @@ def test_a_jpeg_drawing_without_a_visible_grid_has_flat_blocks_and_a_photo_not()
     assert hidden_compression(photo) == NO_COMPRESSION
 
 
+def _screentone_page():
+    """512 x 512 px of a comic page: three framed panels, dots of screentone (6 px apart) over
+    part of each, white paper between; antialiased at 4 x 4, grey."""
+    y, x = np.mgrid[0:2048, 0:2048] / 4.0
+    ink = np.ones((2048, 2048), np.float32)
+    for top, left, height, width in ((20, 20, 220, 230), (20, 270, 220, 220), (270, 20, 220, 470)):
+        inside = (y >= top) & (y < top + height) & (x >= left) & (x < left + width)
+        dots = (np.mod(x, 6) - 3) ** 2 + (np.mod(y, 6) - 3) ** 2 < 1.6 ** 2
+        ink[inside & dots & (x < left + 0.6 * width)] = 0.15
+        ink[inside & ~((y >= top + 3) & (y < top + height - 3) & (x >= left + 3) & (x < left + width - 3))] = 0.0
+    page = np.rint(ink.reshape(512, 4, 512, 4).mean(axis=(1, 3)) * 255).astype(np.uint8)
+    return np.repeat(page[..., None], 3, axis=2)
+
+
+def test_a_lossless_page_flat_at_every_phase_is_no_hidden_jpeg(monkeypatch):
+    """A lossless page's edge-free blocks are flat at every phase of the 8 x 8 grid, a JPEG's
+    only near its own (LOSSLESS_PHASE_GAP): on a 512 x 512 window, with its 64 phases, the PNG
+    page is no JPEG drawing, its JPEG twins at q 75-90 (no grid seen in their pixels) are."""
+    from aarecovery.plan.compression import LOSSLESS_PHASE_GAP, hidden_compression
+    page = _screentone_page()
+    assert hidden_compression(_encoded(page)) == NO_COMPRESSION
+    for quality in (75, 90):
+        jpeg = _encoded(_jpeg_round_trip(page, quality))
+        assert not compression_evidence(jpeg).compressed, quality
+        assert hidden_compression(jpeg).source == "flat blocks", quality
+    # Without the test of the phases the PNG page read as a JPEG drawing.
+    import aarecovery.plan.compression as compression
+    assert LOSSLESS_PHASE_GAP > 0
+    monkeypatch.setattr(compression, "LOSSLESS_PHASE_GAP", -1.0)
+    assert hidden_compression(_encoded(page)).source == "flat blocks"
+
+
 def test_an_unsharp_mask_on_a_jpeg_drawing_is_repaired():
     # Read by its flat blocks, the q 98 page is hard-edged content under an unsharp mask (F
     # was kept as a textured image's); the star burst at q 85 (grid found) is repaired at a
