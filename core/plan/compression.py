@@ -52,7 +52,7 @@ BLOCK_GRAIN_SHARE = 0.15
 #: 768 px (their 512 x 512 windows, 64 phases each), least / median share: PNG manga 0.00 /
 #: 0.00, map 0.025 / 0.038, serif 0.016 / 0.063; JPEG (q 85-95) manga 0.00 / 0.10-0.11, map
 #: 0.03 / 0.45-0.49, serif 0.14 / 0.34-0.45, star burst 0.075 / 0.83; a sparse screentone page
-#: (tests/test_compression.py) 0.00 / 0.00 as a PNG, 0.00 / 0.028 and 0.024 at q 90 and 95,
+#: (tests/test_jpeg_evidence.py) 0.00 / 0.00 as a PNG, 0.00 / 0.028 and 0.024 at q 90 and 95,
 #: 0.00 / 0.00 at q 98. Between the lossless 0.013 and the sparse JPEG's 0.024 (serif's PNG,
 #: 0.047, still reads as compressed, as before the test). Of the 240 cases at 768 px (ten
 #: tools, PNG and JPEG), one moved: the manga under OpenCV's bilateral filter, 0.51 -> 0.93 of
