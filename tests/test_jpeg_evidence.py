@@ -174,7 +174,7 @@ def _page(family, space, quality):
     from aarecovery.lab.realtools import render_family
     from aarecovery.plan.resample import box_downsample
     page = np.rint(box_downsample(render_family(family, 96), 8, space) * 255).astype(np.uint8)
-    return _encoded(_jpeg_round_trip(page, quality))
+    return _encoded(page if quality is None else _jpeg_round_trip(page, quality))
 
 
 def _rgba(encoded):
@@ -234,22 +234,29 @@ def test_a_lossless_page_flat_at_every_phase_is_no_hidden_jpeg(monkeypatch):
 
 def test_an_unsharp_mask_on_a_jpeg_drawing_is_repaired():
     # Read by its flat blocks, the q 98 page is hard-edged content under an unsharp mask (F
-    # was kept as a textured image's); the star burst at q 85 (grid found) is repaired at a
-    # repair-to-error ratio below the bar a smoothing filter needs on compressed content.
+    # was kept as a textured image's), repaired at full strength; the star burst at q 85 (grid
+    # found) is repaired at a repair-to-error ratio below the bar a smoothing filter needs on
+    # compressed content, at the lower strength a sharpening filter gets there, and its PNG
+    # twin at full strength.
     from aarecovery.filters.spatial import unsharp_mask
     from aarecovery.plan.analysis import analyse
-    from aarecovery.plan.compression import COMPRESSED_REPAIR_TO_ERROR
+    from aarecovery.plan.compression import COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SHARPENED_STRENGTH
     from aarecovery.plan.model_error import repair_to_error_ratio
-    for family, quality in (("serif", 98), ("starburst", 85)):
+    assert COMPRESSED_SHARPENED_STRENGTH < 1.0
+    for family, quality, strength in (("serif", 98, 1.0), ("starburst", 85, COMPRESSED_SHARPENED_STRENGTH),
+                                      ("starburst", None, 1.0)):
         page = _page(family, "linear", quality)
         filtered = np.clip(unsharp_mask(page, radius=1.5, amount=1.5), 0, 1).astype(np.float32)
         analysis = analyse(_rgba(page), _rgba(filtered))
         assert analysis.decision == aarecovery.Decision.NEIGHBOURHOOD_HARD_EDGED, analysis.reason
-        assert analysis.strength == 1.0
-    assert compression_evidence(page).source == "block grid"
-    ratio = repair_to_error_ratio(_rgba(page), _rgba(filtered), linear_input=False, blend_space=analysis.blend_space,
-                                  sigma_d=aarecovery.params.SIGMA_D.default, sigma_e=aarecovery.params.SIGMA_E.default)
-    assert ratio < COMPRESSED_REPAIR_TO_ERROR
+        assert analysis.strength == strength, (family, quality, analysis.reason)
+        if quality == 85:
+            assert compression_evidence(page).source == "block grid"
+            ratio = repair_to_error_ratio(_rgba(page), _rgba(filtered), linear_input=False,
+                                          blend_space=analysis.blend_space, sigma_d=aarecovery.params.SIGMA_D.default,
+                                          sigma_e=aarecovery.params.SIGMA_E.default)
+            assert ratio < COMPRESSED_REPAIR_TO_ERROR
+            assert f"strength {COMPRESSED_SHARPENED_STRENGTH:g}" in analysis.reason
 
 
 def _curve_case(family, space, quality, curve):

@@ -33,7 +33,7 @@ from ..colour import REC601_LUMA
 __all__ = ["quiet_block_grain", "hidden_compression", "BLOCK_GRAIN_SHARE", "CompressionEvidence", "NO_COMPRESSION", "BLOCK", "noise_from_tables", "detect_block_grid",
            "compression_evidence", "GRID_MARGIN", "STANDARD_LUMA_TABLE",
            "NOISE_CONTRAST_SIGMAS", "MIN_NOISE_CONTRAST",
-           "COMPRESSED_REPAIR_TO_ERROR", "COMPRESSED_SMOOTHED_STRENGTH", "LOSSLESS_TEST_PHASES", "LOSSLESS_PHASE_GAP"]
+           "COMPRESSED_REPAIR_TO_ERROR", "COMPRESSED_SMOOTHED_STRENGTH", "COMPRESSED_SHARPENED_STRENGTH", "LOSSLESS_TEST_PHASES", "LOSSLESS_PHASE_GAP"]
 
 #: Side of a JPEG block, in pixels of the luma plane.
 BLOCK = 8
@@ -79,7 +79,8 @@ _MIN_QUIET_BLOCKS = 16
 #: held out, every repaired case had a ratio over 100. A sharpening filter (an unsharp mask)
 #: needs only :data:`~aarecovery.plan.model_error.MIN_REPAIR_TO_ERROR`: on the tuning half's
 #: JPEG drawings it gained at every ratio from 5 up (the star burst 5.0 and 6.9: 0.60 and 0.28
-#: of its edge error; serif 13-20: 0.20-0.66), and the bar kept F on the star burst.
+#: of its edge error; serif 13-20: 0.20-0.66), and the bar kept F on the star burst; below
+#: it a sharpening filter runs at :data:`COMPRESSED_SHARPENED_STRENGTH`.
 COMPRESSED_REPAIR_TO_ERROR = 10.0
 #: The strength under a smoothing filter (``aarecovery.plan.smoothing``) on hard-edged
 #: content from a JPEG, without pure colours: the filter spreads the compression noise over
@@ -88,6 +89,16 @@ COMPRESSED_REPAIR_TO_ERROR = 10.0
 #: strength (0.75 with pure colours where flat colours are kept) 2 cases worse than F by over
 #: 0.1 dB (serif under OpenCV's smoothing at q 75: 0.91 dB); 0.75: 1 (0.34 dB); 0.5: none.
 COMPRESSED_SMOOTHED_STRENGTH = 0.5
+#: The strength under a sharpening filter (an unsharp mask, detail enhancement) on hard-edged
+#: content from a JPEG whose repair-to-error ratio is below :data:`COMPRESSED_REPAIR_TO_ERROR`:
+#: the filter sharpens the ringing beside the edges with them, and the pure colours' repair
+#: lays the model's error over it. Tuning half, maps, serif, icons, star burst and manga under
+#: GEGL's and ImageMagick's unsharp masks from JPEGs (q 75-98; 18 cases reach it, the star
+#: burst at 96 px, the maps at 768 px), mean edge error reduction at full strength 0.323 (the
+#: sRGB maps at 768 px worse than F by 0.10-0.42 dB), 0.75: 0.420, 0.5: 0.441 (least 0.247).
+#: Above the ratio full strength did better on most (serif and manga, 96 and 768 px: 0.75
+#: lower on 25 of 30 cases; higher on 3 of serif's 4 at 768 px, by 0.010-0.029).
+COMPRESSED_SHARPENED_STRENGTH = 0.5
 #: Extremes closer than this many standard deviations of the compression noise are not a
 #: thin feature and its paper (``PureColourPrior.noise_contrast``). Measured on JPEG scans of
 #: text on tinted paper thresholded at 55 % (256 x 256 pages, 40 px margins), F's background
