@@ -78,7 +78,7 @@ from ..spec.sobel import gradient_magnitude
 from .blend_space import choose_blend_space
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
-from .compression import (COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SHARPENED_STRENGTH, COMPRESSED_SMOOTHED_STRENGTH, GRID_MARGIN, compression_evidence,
+from .compression import (COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SHARPENED_BLEND_SPACE, COMPRESSED_SHARPENED_STRENGTH, COMPRESSED_SMOOTHED_STRENGTH, GRID_MARGIN, compression_evidence,
                           hidden_compression)
 from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
@@ -524,6 +524,9 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         return PairAnalysis(SHARPENED_GRAIN_BLEND_SPACE, 1.0, why + f" that sharpens {grain.describe()}: full "
                                                                "strength at the grain's edge scale" + pure,
                             Decision.NEIGHBOURHOOD_HARD_EDGED, prior, edge_scale=grain.edge_scale)
+    # On a JPEG a sharpening filter blends in sRGB values (see COMPRESSED_SHARPENED_BLEND_SPACE).
+    if compression.compressed and not smoothing and not linear_input:
+        space = COMPRESSED_SHARPENED_BLEND_SPACE
     # A sharpening filter sharpens a JPEG's ringing beside the edges too; where the repairs are
     # not clearly larger than the model's own error (below the bar a smoothing filter needs),
     # the repair runs at a lower strength (see COMPRESSED_SHARPENED_STRENGTH).

@@ -33,7 +33,7 @@ from ..colour import REC601_LUMA
 __all__ = ["quiet_block_grain", "hidden_compression", "BLOCK_GRAIN_SHARE", "CompressionEvidence", "NO_COMPRESSION", "BLOCK", "noise_from_tables", "detect_block_grid",
            "compression_evidence", "GRID_MARGIN", "STANDARD_LUMA_TABLE",
            "NOISE_CONTRAST_SIGMAS", "MIN_NOISE_CONTRAST",
-           "COMPRESSED_REPAIR_TO_ERROR", "COMPRESSED_SMOOTHED_STRENGTH", "COMPRESSED_SHARPENED_STRENGTH", "LOSSLESS_TEST_PHASES", "LOSSLESS_PHASE_GAP"]
+           "COMPRESSED_REPAIR_TO_ERROR", "COMPRESSED_SMOOTHED_STRENGTH", "COMPRESSED_SHARPENED_STRENGTH", "COMPRESSED_SHARPENED_BLEND_SPACE", "LOSSLESS_TEST_PHASES", "LOSSLESS_PHASE_GAP"]
 
 #: Side of a JPEG block, in pixels of the luma plane.
 BLOCK = 8
@@ -105,6 +105,18 @@ COMPRESSED_SMOOTHED_STRENGTH = 0.5
 #: Above the ratio full strength did better on most (serif and manga, 96 and 768 px: 0.75
 #: lower on 25 of 30 cases; higher on 3 of serif's 4 at 768 px, by 0.010-0.029).
 COMPRESSED_SHARPENED_STRENGTH = 0.5
+#: The space a sharpening filter's repair blends in on hard-edged content from a JPEG (not
+#: from linear-light input, not on a coarse paper grain: ``paper_grain``), whatever space
+#: O's colour lines told: the compression's noise and ringing lie in the encoded values,
+#: and the filter sharpens them there. Tuning half, drawings under GEGL's and ImageMagick's
+#: unsharp masks from JPEGs (q 75-98), the cases it moved: 96 px 0.513 -> 0.519 (24 cases:
+#: manga up to +0.30, serif down to -0.26), 768 px 0.536 -> 0.626 (25: serif +0.09 to
+#: +0.23, manga +0.03 to +0.36, maps -0.15 to +0.07); none worse than F. Held out (chosen
+#: before they were run): 96 px, 12 families under G'MIC's and Pillow's unsharp masks and
+#: OpenCV's detail enhancement, 10 cases moved, 0.547 -> 0.709, every one up; 768 px, the
+#: hatching, comic strip, pie charts and plots under Pillow's unsharp mask and OpenCV's
+#: detail enhancement, 8 cases, 0.313 -> 0.498, every one up.
+COMPRESSED_SHARPENED_BLEND_SPACE = "srgb"
 #: Extremes closer than this many standard deviations of the compression noise are not a
 #: thin feature and its paper (``PureColourPrior.noise_contrast``). Measured on JPEG scans of
 #: text on tinted paper thresholded at 55 % (256 x 256 pages, 40 px margins), F's background
