@@ -70,9 +70,17 @@ def _cv_equalize(cv2, rgb, p):
     return cv2.cvtColor(ycrcb, cv2.COLOR_YCrCb2RGB)
 
 
-def _cv_turbo(cv2, rgb, p):
+def _colour_map(cv2, rgb, colour_map):
     grey = cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY)
-    return cv2.cvtColor(cv2.applyColorMap(grey, cv2.COLORMAP_TURBO), cv2.COLOR_BGR2RGB)
+    return cv2.cvtColor(cv2.applyColorMap(grey, colour_map), cv2.COLOR_BGR2RGB)
+
+
+def _cv_turbo(cv2, rgb, p):
+    return _colour_map(cv2, rgb, cv2.COLORMAP_TURBO)
+
+
+def _cv_jet(cv2, rgb, p):
+    return _colour_map(cv2, rgb, cv2.COLORMAP_JET)
 
 
 def _pil_posterize(pil, image, p):
@@ -185,7 +193,7 @@ OPENCV = PythonTool("opencv", "OpenCV", "cv2", "opencv-python-headless",
                     {"bilateral": _cv_bilateral, "edge-preserving": _cv_edge_preserving,
                      "detail-enhance": _cv_detail_enhance,
                      "threshold": _cv_threshold, "gamma": _cv_gamma, "equalize": _cv_equalize,
-                     "turbo": _cv_turbo}, _run_opencv)
+                     "turbo": _cv_turbo, "jet": _cv_jet}, _run_opencv)
 PILLOW = PythonTool("pillow", "Pillow (ImageOps, ImageFilter)", "PIL", "Pillow",
                     {"posterize": _pil_posterize, "solarize": _pil_solarize, "equalize": _pil_equalize,
                      "ycbcr-equalize": _pil_ycbcr_equalize, "autocontrast": _pil_autocontrast, "unsharp": _pil_unsharp,

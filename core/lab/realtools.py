@@ -222,13 +222,15 @@ TOOL_FILTERS = {f.name: f for f in (
     # OpenCV and Pillow, in-process (aarecovery.lab.pytools). Each half gets a smoothing
     # filter, an abstraction, a curve and a threshold or equalization of its own:
     # tune: bilateral, normalized-convolution smoothing, LUT gamma, threshold; Pillow's posterize, solarize (a
-    # non-monotonic curve), autocontrast and the equalization of YCbCr's luma.
+    # non-monotonic curve), autocontrast and the equalization of YCbCr's luma; a JET colour
+    # map of the grey value (non-monotonic in green and blue).
     _tf("cv-bilateral", "opencv", ["bilateral", "sigma_space={sigma}", "sigma_colour=40"], "bilateral", "tune",
         {"sigma": 1.5}),
     _tf("cv-smoothing", "opencv", ["edge-preserving", "flags=2", "sigma_s={sigma}", "sigma_r=0.3"], "abstraction",
         "tune", {"sigma": 6.0}),
     _tf("cv-gamma", "opencv", ["gamma", "gamma=2.2"], "curves", "tune"),
     _tf("cv-threshold", "opencv", ["threshold", "value=127"], "threshold", "tune"),
+    _tf("cv-jet", "opencv", ["jet"], "gradient-map", "tune"),
     _tf("pil-posterize", "pillow", ["posterize", "bits=2"], "posterize", "tune"),
     _tf("pil-solarize", "pillow", ["solarize", "threshold=160"], "curves", "tune"),
     _tf("pil-autocontrast", "pillow", ["autocontrast", "cutoff=2"], "levels", "tune", whole_image=True),
@@ -322,7 +324,7 @@ REAL_FULL = RealToolsSuite("realtools", _ALL_FAMILIES, _ALL_FILTERS, 96,
 #: filters added with OpenCV and Pillow it runs one neighbourhood filter per half, and a
 #: non-monotonic curve (tune) or the scanning threshold (held out): each filter adds ten
 #: cases to a half, and the other eleven would nearly double its time.
-_QUICK_LEAVES_OUT = {"cv-smoothing", "cv-gamma", "cv-threshold", "pil-posterize", "pil-autocontrast",
+_QUICK_LEAVES_OUT = {"cv-smoothing", "cv-gamma", "cv-jet", "cv-threshold", "pil-posterize", "pil-autocontrast",
                      "cv-detail-enhance", "cv-equalize", "cv-turbo", "pil-equalize", "pil-unsharp", "pil-gradient-map"}
 REAL_QUICK = RealToolsSuite("realtools-quick", ("maps", "starburst", "text", "coffee", "poster", "hatching", "pies",
                                                 "towers", "rocket", "banner"),

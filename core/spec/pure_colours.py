@@ -38,9 +38,10 @@ filtered directly:
   :func:`scale_transfer`) are that form; with them the extension covers those filters
   (quick suite: tonemap on text/lines 0.39-0.52 -> 0.72-0.96, equalize 0.37-0.47 -> 0.81-0.90).
 
-* The table must be monotone (``aarecovery.plan.pure_colours.is_monotone``): tables that
-  match colour to grey or a hue swap by coincidence are not, and extending with them lost
-  up to 7.9 dB (chart).
+* The table must be monotone (``aarecovery.plan.pure_colours.is_monotone``), or, failing
+  that, turn at most once per column (``turns_at_most_once``: a colour map of the grey
+  value, such as JET): tables that match colour to grey or a hue swap by coincidence zigzag,
+  and extending with them lost up to 7.9 dB (chart).
 
 * Over a photo (text, logos and interface chrome drawn on it, ``PureColourPrior.drawn_only``)
   the extension acts only in the regions the local plan reads as drawn, by their smooth
