@@ -9,8 +9,9 @@ restore thin features' pure colours (``plan.pure_colours``) or calibrate the str
 
 import numpy as np
 
-from ..colour import LUMA, REC601_LUMA, largest_channel, luma, srgb_to_linear
-from ..spec.pure_colours import LUMINANCE_KEYS, SCALE_KEYS, SHIFT_KEYS, key_values, scale_transfer, shift_grey
+from ..colour import LUMA, largest_channel, luma, srgb_to_linear
+from ..spec.pure_colours import (LUMINANCE_KEYS, SCALE_KEYS, SHIFT_KEYS, key_values, rec601_grey, scale_transfer,
+                                 shift_grey)
 
 __all__ = ["PointwiseTransfer", "fit_pointwise", "filled_bins", "key_of", "POINTWISE_SHARE", "TABLE_KEYS"]
 
@@ -51,9 +52,10 @@ def key_of(colour, key):
     if key == "max":
         return largest_channel(colour)
     if key == "luma601":
-        # The 8-bit grey those tools index their map by, at its bin's centre: binned raw, a
-        # bin straddled two grey levels and a steep map missed (0.965 of the edges matched).
-        grey = np.rint(np.clip(colour @ np.array(REC601_LUMA, np.float32), 0, 1) * 255)
+        # The 8-bit grey those tools index their map by, at its bin's centre (as the pure
+        # colours read the table, spec.pure_colours.rec601_grey): binned raw, a bin straddled
+        # two grey levels and a steep map missed (0.965 of the edges matched).
+        grey = rec601_grey(np.moveaxis(colour, -1, 0))
         return ((grey + np.float32(0.5)) / np.float32(_LUT_BINS)).astype(np.float32)
     planes = np.ascontiguousarray(colour.reshape(-1, 3).T, dtype=np.float32)
     return key_values(planes, key)[0].reshape(colour.shape[:-1])

@@ -71,7 +71,7 @@ from .sobel import sobel_magnitude
 
 __all__ = ["PureColourPrior", "is_flat_colour", "PALETTE_SIZE", "ON_LINE_TOLERANCE", "KEPT_CONTRAST", "EXTENSION_KEYS",
            "SCALE_KEYS", "SHIFT_KEYS", "filtered_colour", "extend_extreme", "scale_transfer", "key_values", "shift_grey",
-           "fit_pure_colour_model"]
+           "rec601_grey", "fit_pure_colour_model"]
 
 #: Most palette colours kept (a uniform array in the GL pass).
 PALETTE_SIZE = 32
@@ -137,9 +137,10 @@ MIN_CONTRAST = 8.5 / 255
 #: the offset per grey level.
 SHIFT_KEYS = ("luma601_shift", "luma601_floor_shift")
 #: Table keys for which the extension is used (see the module notes).
-EXTENSION_KEYS = ("channel", "luma", "luma_scale", "luminance_scale", "luminance", "luminance_d50") + SHIFT_KEYS
+EXTENSION_KEYS = ("channel", "luma", "luma_scale", "luminance_scale", "luminance", "luminance_d50",
+                  "luma601") + SHIFT_KEYS
 _KEY_CODES = {"channel": 0, "luma": 1, "luma_scale": 2, "luminance_scale": 3, "luminance": 4, "luminance_d50": 5,
-              "luma601_shift": 6, "luma601_floor_shift": 7}
+              "luma601_shift": 6, "luma601_floor_shift": 7, "luma601": 8}
 # The tools' fixed-point Rec. 601 Y of 8-bit R, G, B (each matched 262,144 random colours
 # exactly): OpenCV's weights in 1/16384 with rounding; Pillow's YCbCr sums its weights times
 # 64, each rounded to a whole number, and truncates (its Y is a level below the rounded
@@ -147,6 +148,9 @@ _KEY_CODES = {"channel": 0, "luma": 1, "luma_scale": 2, "luminance_scale": 3, "l
 # 2^24: exact in float32 on both backends.
 _OPENCV_Y = (4899.0, 9617.0, 1868.0, 16384.0)
 _PILLOW_Y = (19.136, 37.568, 7.296, 64.0)
+# The rounded Rec. 601 grey of 8-bit R, G, B in thousandths (``"luma601"``, :func:`rec601_grey`):
+# whole numbers, so both backends round the same grey at a tie.
+_REC601_Y = (299.0, 587.0, 114.0, 1000.0)
 #: Keys of one value per pixel: the encoded value of the luminance of linear light, with the
 #: Rec. 709 weights or babl's D50 ones (colour to grey and thresholds by luminance).
 LUMINANCE_KEYS = {"luminance": LUMA_WEIGHTS, "luminance_d50": np.array(LUMINANCE_D50, np.float32)}
@@ -172,7 +176,8 @@ class PureColourPrior:
         encoded value of its luminance (:data:`LUMINANCE_KEYS`); the scale keys map luma
         (encoded) or luminance (linear) and scale colour with it (:func:`scale_transfer`);
         the shift keys add an offset of the 8-bit Rec. 601 grey to every channel
-        (:data:`SHIFT_KEYS`).
+        (:data:`SHIFT_KEYS`); ``"luma601"`` indexes every column by that grey, rounded
+        (:func:`rec601_grey`: OpenCV's colour maps of a colour image).
     table : ndarray of float32, shape (256, 3)
         Encoded output colour per bin of the key; read with linear interpolation between
         bin centres ``(i + 0.5) / 256``.
@@ -255,7 +260,7 @@ class PureColourPrior:
     @property
     def key_code(self):
         """int: the GL define ``TABLE_KEY`` (0 channel, 1 luma, 2 luma_scale, 3 luminance_scale,
-        4 luminance, 5 luminance_d50, 6 luma601_shift, 7 luma601_floor_shift)."""
+        4 luminance, 5 luminance_d50, 6 luma601_shift, 7 luma601_floor_shift, 8 luma601)."""
         return _KEY_CODES[self.key]
 
     def palette_in(self, blend_space):
@@ -331,12 +336,30 @@ def shift_grey(encoded, key):
     return np.clip(grey, 0, 255).astype(np.float32)
 
 
+def rec601_grey(encoded):
+    """The 8-bit Rec. 601 grey level of encoded colour planes ``(3, ...)``, rounded: float32
+    of whole numbers in [0, 255].
+
+    The grey that OpenCV's colour maps, Pillow's ``convert("L")`` and ImageMagick's
+    ``Rec601Luma`` index by (each to within a level at a tie), from the 8-bit channels in
+    thousandths, ``(299 R + 587 G + 114 B + 500) // 1000``: whole numbers below 2^24, exact
+    in float32 on both backends.
+    """
+    levels = [np.floor(np.clip(encoded[c], 0, 1) * np.float32(255) + np.float32(0.5)) for c in range(3)]
+    r, g, b, scale = (np.float32(v) for v in _REC601_Y)
+    grey = np.floor((levels[0] * r + levels[1] * g + levels[2] * b + scale / 2) / scale)
+    return np.clip(grey, 0, 255).astype(np.float32)
+
+
 def key_values(encoded, key):
     """The table keys of encoded colour planes ``(3, N)``: shape (3, N), one row per table
     column (luma, luminance, the scale and the shift keys repeat one value; a shift key's is
     its grey level's bin centre)."""
     if key in SHIFT_KEYS:
         return np.broadcast_to(((shift_grey(encoded, key) + np.float32(0.5)) / np.float32(256)).astype(np.float32),
+                               encoded.shape)
+    if key == "luma601":
+        return np.broadcast_to(((rec601_grey(encoded) + np.float32(0.5)) / np.float32(256)).astype(np.float32),
                                encoded.shape)
     if key in LUMINANCE_KEYS:
         weights = LUMINANCE_KEYS[key]

@@ -26,6 +26,7 @@ uniform float luma_purity;         // an extreme whose luma is within this of a 
 //            with it (scale_transfer)
 //            6/7: the 8-bit Rec. 601 grey (rounded / truncated) indexes an offset added to
 //            every channel (SHIFT_KEYS, shift_grey)
+//            8: the 8-bit Rec. 601 grey, rounded, indexes all (rec601_grey)
 // CLAMP_ENDS: 1: an extreme at an end of the range reads the table clamped
 // TO_CUBE: 0: extend only to a flat colour of O beyond the extreme
 #ifndef TABLE_KEY
@@ -57,9 +58,11 @@ const float RANGE_TOLERANCE = 0.05;
 const float END_TOLERANCE = 1.0 / 255.0;
 const float MIN_CONTRAST = 8.5 / 255.0;
 const float MIN_REACH = 1.2001;
-// The tools' fixed-point Rec. 601 Y (spec.pure_colours._OPENCV_Y, _PILLOW_Y): weights and scale.
+// The tools' fixed-point Rec. 601 Y (spec.pure_colours._OPENCV_Y, _PILLOW_Y, _REC601_Y):
+// weights and scale.
 const vec4 OPENCV_Y = vec4(4899.0, 9617.0, 1868.0, 16384.0);
 const vec4 PILLOW_Y = vec4(19.136, 37.568, 7.296, 64.0);
+const vec4 REC601_Y = vec4(299.0, 587.0, 114.0, 1000.0);
 
 float table_at(float key, int channel) {
     // Linear interpolation between bin centres, two fetches (no texture filtering: llvmpipe's
@@ -107,6 +110,13 @@ vec3 key_values(vec3 encoded) {
     float grey = floor((floor(levels.r * PILLOW_Y.x + 0.5) + floor(levels.g * PILLOW_Y.y + 0.5)
                         + floor(levels.b * PILLOW_Y.z + 0.5)) / PILLOW_Y.w);
 #endif
+    grey = clamp(grey, 0.0, 255.0);
+    return vec3((grey + 0.5) / 256.0);
+#elif TABLE_KEY == 8
+    // The rounded grey in thousandths (rec601_grey): whole numbers, exact in float.
+    vec3 levels = floor(clamp(encoded, 0.0, 1.0) * 255.0 + 0.5);
+    float grey = floor((levels.r * REC601_Y.x + levels.g * REC601_Y.y + levels.b * REC601_Y.z + REC601_Y.w / 2.0)
+                       / REC601_Y.w);
     grey = clamp(grey, 0.0, 255.0);
     return vec3((grey + 0.5) / 256.0);
 #elif TABLE_KEY == 4 || TABLE_KEY == 5
