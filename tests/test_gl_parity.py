@@ -320,14 +320,12 @@ def test_rec601_grey_keyed_tables_agree(gl_engine):
     """A colour map of a colour image's 8-bit Rec. 601 grey, as OpenCV's applyColorMap takes
     it: the table is keyed by that grey (table key 8) on both backends, which round it from
     the 8-bit channels in whole numbers."""
+    from test_pure_colours import opencv_jet_of_grey
+
     from aarecovery.lab.scenes import render
     from aarecovery.plan.resample import box_downsample
     original = np.rint(box_downsample(render("chart", 64, 4), 4, "srgb") * 255).astype(np.uint8)
-    levels = original.astype(np.int64)
-    grey = (4899 * levels[..., 0] + 9617 * levels[..., 1] + 1868 * levels[..., 2] + 8192) >> 14
-    ramp = np.array([(0, 0, 128), (0, 128, 255), (128, 255, 128), (255, 128, 0), (128, 0, 0)])
-    filtered = np.stack([np.interp(grey, np.linspace(0, 255, len(ramp)), ramp[:, c]) for c in range(3)], -1)
-    filtered = np.rint(filtered).astype(np.uint8)
+    filtered = np.rint(opencv_jet_of_grey(original / np.float32(255)) * 255).astype(np.uint8)
     gl_engine.set_images(original, filtered)
     gl_engine.compute()
     assert gl_engine.last_plan.pure_colours.key == "luma601"

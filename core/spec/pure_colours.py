@@ -150,7 +150,7 @@ _OPENCV_Y = (4899.0, 9617.0, 1868.0, 16384.0)
 _PILLOW_Y = (19.136, 37.568, 7.296, 64.0)
 # The rounded Rec. 601 grey of 8-bit R, G, B in thousandths (``"luma601"``, :func:`rec601_grey`):
 # whole numbers, so both backends round the same grey at a tie.
-_REC601_Y = (299.0, 587.0, 114.0, 1000.0)
+_REC601_Y = tuple(float(round(weight * 1000)) for weight in REC601_LUMA) + (1000.0,)
 #: Keys of one value per pixel: the encoded value of the luminance of linear light, with the
 #: Rec. 709 weights or babl's D50 ones (colour to grey and thresholds by luminance).
 LUMINANCE_KEYS = {"luminance": LUMA_WEIGHTS, "luminance_d50": np.array(LUMINANCE_D50, np.float32)}
