@@ -9,7 +9,7 @@ import pytest
 
 from aarecovery.lab import realtools
 from aarecovery.lab.comics import COMICS
-from aarecovery.lab.metrics import HAZE_TOLERANCE, haze_pixels
+from aarecovery.lab.metrics import HAZE_TOLERANCE, flat_areas, haze_pixels
 from aarecovery.lab.overlays import MIXED, SCANS, overlay_regions, paper_background
 from aarecovery.lab.tools import TOOLS
 from test_realtools import require_tool
@@ -79,6 +79,24 @@ def test_haze_counts_a_synthetic_haze_and_is_zero_on_f():
     lighter = filtered.copy()
     lighter[8:12, 5:25] = 0.2
     assert haze_pixels(lighter, filtered, np.ones((20, 30), bool)) == 0  # only darker counts
+
+
+def test_flat_areas_are_where_fs_3x3_neighbourhood_is_one_8_bit_colour():
+    filtered = np.ones((12, 16, 3), np.float32)  # a thresholded page's white ...
+    filtered[5, 4:12] = 0  # ... a line of ink ...
+    filtered[10, 14] = (1, 1, 254 / 255)  # ... and one blue level off white (a grain speck)
+    flat = flat_areas(filtered)
+    assert flat.shape == (12, 16) and flat[0, 0] and flat[8, 8]
+    assert not flat[4:7, 3:13].any()  # the line and every pixel beside it
+    assert not flat[9:12, 13:16].any() and flat[9, 12]
+    # Half an 8-bit level apart is still flat; the haze counted on F's flat paper only.
+    filtered[0, 0] = 1 - 0.4 / 255
+    assert flat_areas(filtered)[0, 1]
+    hazy = filtered.copy()
+    hazy[0:2, 0:16] = 0.9  # 32 paper pixels greyed: 32 on the paper, 32 of them where F is flat
+    hazy[4, 4] = 0.9  # beside the ink, where F is not flat: darker, but not haze
+    assert haze_pixels(hazy, filtered, np.ones((12, 16), bool)) == 33
+    assert haze_pixels(hazy, filtered, flat_areas(filtered)) == 32
 
 
 def test_cases_carry_regions_and_paper():
@@ -177,7 +195,8 @@ def test_summary_prints_regions_haze_and_neighbourhood_filters():
     mixed = [r for r in results if r.kind == "mixed"]
     assert mixed and all(set(r.region_reduction) == {"text/graphics", "photo"} for r in mixed)
     scans = [r for r in results if r.kind == "scan"]
-    assert scans and all(r.haze["F"] == 0 and r.paper_pixels > 0 for r in scans)
+    assert scans and all(r.haze["F"] == 0 and r.darker["F"] == 0 and 0 < r.flat_paper_pixels <= r.paper_pixels
+                         and r.haze["R"] <= r.darker["R"] and "reference" in r.darker for r in scans)
     summary = summarize_realtools(results)
     assert summary["mixed"]["text/graphics"][1] > 0 and summary["neighbourhood_cases"] > 0
     assert "png" in summary["haze"] and "jpeg" in summary["haze"]

@@ -11,7 +11,7 @@ from ..filters.spatial import gaussian_filter
 from ..spec.sobel import image_gradients
 
 __all__ = ["mse", "psnr", "ssim", "ssim_map", "edge_band", "error_reduction", "outside_local_range", "haze_pixels",
-           "HAZE_TOLERANCE"]
+           "flat_areas", "HAZE_TOLERANCE", "FLAT_AREA_SPAN"]
 
 # An edge-band pixel is one where the reference and F differ by more than this (they
 # disagree there, so that is where a repair is needed or can harm) ...
@@ -23,6 +23,9 @@ _PSNR_CAP = 100.0
 #: How much darker than F a background pixel may come out before it counts as haze: two
 #: 8-bit steps of luma, above the rounding of any repair but far below a visible blotch.
 HAZE_TOLERANCE = 2.0 / 255
+#: F is flat at a pixel where its 3 x 3 neighbourhood spans at most this in every channel:
+#: equal 8-bit values (a thresholded page's white, a posterized level's fill).
+FLAT_AREA_SPAN = 0.5 / 255
 _LUMA = LUMA_WEIGHTS  # Rec. 709, on encoded values
 
 
@@ -129,6 +132,24 @@ def outside_local_range(image, filtered, slack=1.0 / 255):
     windows = [padded[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
     low, high = np.minimum.reduce(windows), np.maximum.reduce(windows)
     return ((image < low - slack) | (image > high + slack)).any(axis=-1)
+
+
+def flat_areas(image):
+    """bool ``(H, W)``: where `image`'s 3 x 3 neighbourhood (borders replicated) spans at most
+    :data:`FLAT_AREA_SPAN` in every channel: its flat areas, where haze would show.
+
+    Parameters
+    ----------
+    image : ndarray of float32, shape (H, W, 3)
+    """
+    height, width = image.shape[:2]
+    padded = np.pad(np.asarray(image, np.float32), ((1, 1), (1, 1), (0, 0)), mode="edge")
+    brightest, darkest = padded[1:height + 1, 1:width + 1].copy(), padded[1:height + 1, 1:width + 1].copy()
+    for dy in range(3):
+        for dx in range(3):
+            np.maximum(brightest, padded[dy:dy + height, dx:dx + width], out=brightest)
+            np.minimum(darkest, padded[dy:dy + height, dx:dx + width], out=darkest)
+    return (brightest - darkest).max(axis=-1) <= np.float32(FLAT_AREA_SPAN)
 
 
 def haze_pixels(image, filtered, background, tolerance=HAZE_TOLERANCE):

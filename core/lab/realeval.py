@@ -69,10 +69,16 @@ class RealCaseResult(CaseResult):
     region_reduction : dict of str to dict of str to float
         Mixed content: per region, per method, the edge-band error reduction there.
     haze : dict of str to int
-        Scans: per method, paper pixels it makes darker than F
-        (:func:`~aarecovery.lab.metrics.haze_pixels`).
-    paper_pixels : int
-        Scans: the size of the paper background.
+        Scans: per method, pixels of the paper where F is flat that it makes darker than F
+        (:func:`~aarecovery.lab.metrics.haze_pixels` on
+        :func:`~aarecovery.lab.metrics.flat_areas`): O's grain or ringing painted on paper
+        that F shows as one colour.
+    darker : dict of str to int
+        Scans: per method and for the reference, paper pixels anywhere (F flat or not) made
+        darker than F: where F keeps a grain or the filter's blotches, the reference is often
+        darker than F there too, and a repair that moves towards it is counted.
+    paper_pixels, flat_paper_pixels : int
+        Scans: the size of the paper background, and of its part where F is flat.
     """
 
     tool: str = ""
@@ -85,7 +91,9 @@ class RealCaseResult(CaseResult):
     region_error: dict = field(default_factory=dict)
     region_reduction: dict = field(default_factory=dict)
     haze: dict = field(default_factory=dict)
+    darker: dict = field(default_factory=dict)
     paper_pixels: int = 0
+    flat_paper_pixels: int = 0
 
     @property
     def source(self):
@@ -150,7 +158,7 @@ def run_realtools(suite, half="tune", *, backend="numpy", peers=True, jpeg=True,
     missing_peers : list of Peer
     """
     from ..engine import Engine
-    from .metrics import edge_band, error_reduction, haze_pixels, mse, outside_local_range, psnr, ssim_map
+    from .metrics import edge_band, error_reduction, flat_areas, haze_pixels, mse, outside_local_range, psnr, ssim_map
     from .peers import available_peers, joint_bilateral
     from .realtools import FAMILIES, TOOL_FILTERS, build_cases
     from .tools import available_tools
@@ -193,8 +201,11 @@ def run_realtools(suite, half="tune", *, backend="numpy", peers=True, jpeg=True,
                 result.region_reduction[region] = {m: error_reduction(image, f, ref, inside)
                                                    for m, image in outputs.items() if m != "F"}
             if case.paper is not None:
-                result.haze = {m: haze_pixels(image, f, case.paper) for m, image in outputs.items()}
-                result.paper_pixels = int(case.paper.sum())
+                flat_paper = case.paper & flat_areas(f)
+                result.haze = {m: haze_pixels(image, f, flat_paper) for m, image in outputs.items()}
+                result.darker = {m: haze_pixels(image, f, case.paper)
+                                 for m, image in {**outputs, "reference": ref}.items()}
+                result.paper_pixels, result.flat_paper_pixels = int(case.paper.sum()), int(flat_paper.sum())
             change = np.abs(recovered - f).max(axis=-1)
             result.changed = float((change > _CHANGED).mean())
             result.max_change = float(change.max())
@@ -336,13 +347,16 @@ def summarize_mixed(results):
 
 
 def summarize_haze(results):
-    """Haze on scans: paper pixels each method makes darker than F, per source.
+    """Haze on scans: pixels of F's flat paper each method makes darker than F, per source.
 
     Returns
     -------
     dict of str to dict
         Per source (``"png"``, ``"jpeg75"``...) and ``"jpeg"`` (every quality): per method,
-        ``(pixels, cases with any, cases)``; ``"paper_pixels"``: the paper background of those cases.
+        ``(pixels, cases with any, cases)``; ``"paper_pixels"`` and ``"flat_paper_pixels"``:
+        the paper background of those cases and its part where F is flat; ``"darker"``: per
+        method and for the reference, ``(pixels, cases with any)`` made darker than F
+        anywhere on the paper (``RealCaseResult.darker``).
     """
     groups = {}
     for r in sorted(results, key=lambda r: (r.quality is not None, r.quality or 0)):
@@ -356,4 +370,7 @@ def summarize_haze(results):
         summary[label] = {m: (sum(r.haze[m] for r in chosen), sum(1 for r in chosen if r.haze[m]), len(chosen))
                           for m in methods}
         summary[label]["paper_pixels"] = sum(r.paper_pixels for r in chosen)
+        summary[label]["flat_paper_pixels"] = sum(r.flat_paper_pixels for r in chosen)
+        summary[label]["darker"] = {m: (sum(r.darker[m] for r in chosen), sum(1 for r in chosen if r.darker[m]))
+                                    for m in [*METHODS, "reference"] if all(m in r.darker for r in chosen)}
     return summary

@@ -150,6 +150,10 @@ def _target_rows(results, summary):
     return rows + _region_rows(summary, others, met)
 
 
+# The methods besides R that the haze row names (the peers run on F alone: GIMP's and G'MIC's
+# antialias, the joint bilateral filter).
+_HAZE_OTHERS = ("paper", "gimp", "gmic", "jbf")
+
 def _region_rows(summary, others, met):
     """The local plan's targets: mixed content per region, neighbourhood filters, haze."""
     rows = []
@@ -179,9 +183,13 @@ def _region_rows(summary, others, met):
     haze = summary.get("haze", {}).get("jpeg")
     if haze and "R" in haze:
         pixels, hazed, cases = haze["R"]
-        rows.append((f"8. JPEG scans: paper pixels R makes darker than F ({cases} cases)", f"{pixels} in {hazed} cases",
-                     ", ".join(f"{m} {haze[m][0]}" for m in haze if m not in ("R", "paper_pixels")), "0",
-                     met(pixels == 0)))
+        darker = haze["darker"]
+        rows.append((f"8. JPEG scans: pixels of F's flat paper that R makes darker than F ({cases} cases)",
+                     f"{pixels} in {hazed} cases",
+                     ", ".join(f"{m} {haze[m][0]}" for m in _HAZE_OTHERS if m in haze)
+                     + "; anywhere on the paper: " + ", ".join(f"{m} {darker[m][0]}" for m in ("R", *_HAZE_OTHERS,
+                                                                                              "reference") if m in darker),
+                     "0", met(pixels == 0)))
     return rows
 
 
@@ -238,9 +246,11 @@ def _haze_lines(results):
     scans = [r for r in results if r.kind == "scan"]
     if not scans:
         return []
-    lines = ["", f"== scans: haze per filter, paper pixels made darker than F by more than {HAZE_TOLERANCE * 255:g}/255 "
-                 "in luma (cases with any / cases)",
-             f"{'filter':26s} {'R png':>14s} {'paper png':>14s} {'R jpeg':>14s} {'paper jpeg':>14s}"]
+    lines = ["", f"== scans: haze per filter, pixels of F's flat paper made darker than F by more than "
+                 f"{HAZE_TOLERANCE * 255:g}/255 in luma (cases with any / cases); anywhere on the paper, R's and "
+                 "the reference's own",
+             f"{'filter':26s} {'R png':>14s} {'paper png':>14s} {'R jpeg':>14s} {'paper jpeg':>14s}"
+             f" {'R anywhere':>11s} {'reference':>10s}"]
     for name in dict.fromkeys(r.filter_name for r in scans):
         cells = []
         for png in (True, False):
@@ -248,7 +258,10 @@ def _haze_lines(results):
             for method in ("R", "paper"):
                 pixels = sum(r.haze.get(method, 0) for r in mine)
                 cells.append(f"{pixels:7d} {sum(1 for r in mine if r.haze.get(method)):2d}/{len(mine):<2d}")
-        lines.append(f"{name:26s} {cells[0]:>14s} {cells[1]:>14s} {cells[2]:>14s} {cells[3]:>14s}")
+        mine = [r for r in scans if r.filter_name == name]
+        anywhere = [sum(r.darker.get(m, 0) for r in mine) for m in ("R", "reference")]
+        lines.append(f"{name:26s} {cells[0]:>14s} {cells[1]:>14s} {cells[2]:>14s} {cells[3]:>14s}"
+                     f" {anywhere[0]:11d} {anywhere[1]:10d}")
     return lines
 
 
@@ -269,9 +282,12 @@ def _issue19_lines(results, summary):
         parts = []
         for label, values in haze.items():
             counts = ", ".join(f"{m} {values[m][0]} px in {values[m][1]}" for m in ("R", "paper", "jbf") if m in values)
-            parts.append(f"{label} ({values['R'][2]} cases, {values['paper_pixels']} paper px): {counts}")
-        lines.append(f"scans: haze, paper pixels made darker than F by more than {HAZE_TOLERANCE * 255:g}/255 in luma; "
-                     f"target 0 (F has none by definition): " + "; ".join(parts))
+            darker = values["darker"]
+            parts.append(f"{label} ({values['R'][2]} cases, {values['flat_paper_pixels']} of {values['paper_pixels']} "
+                         f"paper px flat in F): {counts} (anywhere on the paper: R {darker['R'][0]}, reference "
+                         f"{darker['reference'][0]})")
+        lines.append(f"scans: haze, pixels of F's flat paper made darker than F by more than "
+                     f"{HAZE_TOLERANCE * 255:g}/255 in luma; target 0 (F has none by definition): " + "; ".join(parts))
     return lines
 
 
