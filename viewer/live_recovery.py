@@ -65,7 +65,7 @@ class LiveRecovery:
         aarecovery.InputError
             When the engine refuses the pair; call :meth:`restore_shown_pair` then.
         """
-        self.engine.set_images(pair.original, pair.filtered)
+        self.engine.set_images(pair.original, pair.filtered, quantization=pair.quantization)
         self.pair = pair
         self.computed = None
         self.summary = self._summarized = None
@@ -76,7 +76,7 @@ class LiveRecovery:
         if self.pair is None:
             return
         try:
-            self.engine.set_images(self.pair.original, self.pair.filtered)
+            self.engine.set_images(self.pair.original, self.pair.filtered, quantization=self.pair.quantization)
         except aarecovery.InputError as error:  # the pair loaded before, so this is unexpected
             self.messages.error(f"could not restore the previous images: {error}")
             self.pair = None

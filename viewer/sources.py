@@ -120,11 +120,16 @@ class LoadedPair:
     source : PairSource
     original, filtered : ndarray
         As read (or as the filter returned): any layout and dtype the core accepts.
+    quantization : list of list of int or None
+        The quantization tables of O's file when it is a JPEG (``aarecovery.read_quantization``),
+        so that the viewer's plan reads O's compression noise as ``aarecovery recover`` does
+        for the same files, and shows the same R.
     """
 
     source: PairSource
     original: np.ndarray
     filtered: np.ndarray
+    quantization: object = None
 
     @property
     def size(self):
@@ -155,4 +160,4 @@ def load_pair(source):
             raise aarecovery.InputError("this install has no built-in filters (aarecovery.filters); "
                                         "give a FILTERED image as well")
         filtered = filters.apply(source.filter_name, original, **source.filter_params)
-    return LoadedPair(source, original, filtered)
+    return LoadedPair(source, original, filtered, aarecovery.read_quantization(source.original))

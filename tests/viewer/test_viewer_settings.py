@@ -83,3 +83,43 @@ def test_load_pair_with_a_built_in_filter(tmp_path):
     aarecovery.write_image(tmp_path / "o.png", ramp)
     pair = load_pair(PairSource(str(tmp_path / "o.png"), None, "threshold", {"level": 0.5}))
     assert pair.filtered.shape == ramp.shape and set(np.unique(pair.filtered)) == {0, 255}
+
+
+def _scanned_page(path, quality=85):
+    """A page of serif text on tinted paper, drawn at 4x, box-filtered and saved as JPEG."""
+    from PIL import Image, ImageDraw, ImageFont
+
+    from aarecovery.lab.drawings import SERIF_FONT
+    page = Image.new("RGB", (192 * 4, 192 * 4), (214, 203, 170))
+    draw = ImageDraw.Draw(page)
+    font = ImageFont.truetype(SERIF_FONT, 44)
+    for line in range(5):
+        draw.text((60, 90 + 120 * line), "the quick brown fox jumps", font=font, fill=(35, 30, 45))
+    page.resize((192, 192), Image.BOX).save(path, format="JPEG", quality=quality)
+
+
+def test_a_jpeg_original_is_read_with_its_tables_as_the_command_line_reads_it(tmp_path):
+    # The viewer's engine gets O's JPEG tables (LoadedPair.quantization), so it shows the R
+    # that `aarecovery recover` writes for the same files: without them the plan reads the
+    # compression noise from the pixels, and a scanned page came out different (measured:
+    # 64 pixels on a thresholded page).
+    from aarecovery.cli import main
+    from aarecovery.viewer.live_recovery import LiveRecovery
+    from aarecovery.viewer.messages import MessageLog
+    original, filtered, written = (str(tmp_path / name) for name in ("o.jpg", "f.png", "r.png"))
+    _scanned_page(original)
+    luma = aarecovery.read_image(original).astype(np.float32) @ np.float32([0.2126, 0.7152, 0.0722])
+    aarecovery.write_image(filtered, np.repeat(np.where(luma > 140, 255, 0).astype(np.uint8)[..., None], 3, axis=-1))
+    pair = load_pair(PairSource(original, filtered))
+    assert pair.quantization and pair.quantization == aarecovery.read_quantization(original)
+    assert load_pair(PairSource(filtered, filtered)).quantization is None  # a PNG has none
+    with aarecovery.Engine("numpy") as engine:
+        recovery = LiveRecovery(engine, MessageLog(), lambda: False)
+        recovery.load(pair)
+        assert recovery.update()
+        shown = engine.result()
+        assert "quantization tables" in engine.last_plan.reason
+        without = aarecovery.recover(pair.original, pair.filtered, engine=engine)
+    assert main(["recover", original, filtered, "-o", written, "--backend", "numpy"]) == 0
+    assert np.array_equal(shown, aarecovery.read_image(written))
+    assert not np.array_equal(shown, without)
