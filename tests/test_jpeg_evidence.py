@@ -340,3 +340,43 @@ def test_a_jpegs_smeared_chroma_is_no_thin_feature(monkeypatch):
     monkeypatch.setattr(analysis, "COMPRESSED_LUMA_PURITY", 0.0)
     without, _ = _reduction(*case)
     assert with_luma > 0.1 > 0 > without
+
+
+@pytest.mark.parametrize("options", [dict(quality=5), dict(quality=85, subsampling=0), dict(quality=100),
+                                     dict(quality=70, progressive=True, icc_profile=b"x" * 70000)])
+def test_the_tables_are_read_from_the_header_as_pillow_reads_them(tmp_path, options):
+    pixels = (np.random.default_rng(1).random((40, 50, 3)) * 255).astype(np.uint8)
+    path = tmp_path / "o.jpg"
+    Image.fromarray(pixels).save(path, format="JPEG", **options)
+    with Image.open(path) as image:
+        expected = [list(image.quantization[number]) for number in sorted(image.quantization)]
+    assert aarecovery.read_quantization(path) == expected
+    Image.fromarray(pixels[..., 0]).save(path, format="JPEG", quality=60)      # grey: one table
+    with Image.open(path) as image:
+        assert aarecovery.read_quantization(path) == [list(image.quantization[0])]
+    path.write_bytes(path.read_bytes()[:30])                                   # cut in its header
+    assert aarecovery.read_quantization(path) is None
+
+
+def test_the_tables_of_a_cameras_mpo_file_are_read(tmp_path):
+    # Pillow names a JPEG followed by a second picture MPO; its first picture is what
+    # read_image gives, compressed with these tables.
+    pixels = (np.random.default_rng(2).random((32, 32, 3)) * 255).astype(np.uint8)
+    Image.fromarray(pixels).save(tmp_path / "o.mpo", format="MPO", save_all=True,
+                                 append_images=[Image.fromarray(pixels)], quality=80)
+    with Image.open(tmp_path / "o.mpo") as image:
+        assert image.format == "MPO"
+        expected = [list(image.quantization[number]) for number in sorted(image.quantization)]
+    assert aarecovery.read_quantization(tmp_path / "o.mpo") == expected
+
+
+def test_the_tables_are_read_without_pillow(tmp_path):
+    # Nothing is decoded: a pair read where Pillow is absent (the GIMP plug-in's bundle) or
+    # unwanted still gets its tables.
+    import subprocess
+    import sys
+    Image.new("RGB", (16, 16), (200, 120, 40)).save(tmp_path / "o.jpg", quality=90)
+    script = ("import sys; sys.modules['PIL'] = None; import aarecovery; "
+              f"print(len(aarecovery.read_quantization({str(tmp_path / 'o.jpg')!r})))")
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert run.returncode == 0 and run.stdout.strip() == "2", run.stderr
