@@ -4,8 +4,11 @@ The tolerances are in one table, ``tests/parity.py``: the working-space textures
 relative (float32 rounding of the same sRGB formula), the maps and the final R by dtype.
 """
 
+import io
+
 import numpy as np
 import pytest
+from PIL import Image
 
 import aarecovery
 from aarecovery import spec
@@ -226,6 +229,29 @@ def test_pure_colours_agree_above_a_jpegs_noise(gl_engine):
     actual = aarecovery.recover(original, filtered, engine=gl_engine)
     assert gl_engine.last_plan.pure_colours.noise_contrast > 30 / 255
     assert gl_engine.last_plan.pure_colours.luma_purity > 0
+    expected = aarecovery.recover(original, filtered, backend="numpy")
+    assert np.abs(actual.astype(np.int64) - expected).max() <= 1
+
+
+def test_pure_colours_agree_at_the_floor_of_a_jpegs_noise_contrast(gl_engine):
+    # Where O's noise estimate from its pixels falls to the floor (MIN_NOISE_CONTRAST), 8-bit
+    # extremes must not tie with the contrast they need: at exactly 20 levels GL and NumPy
+    # took different extremes as thin features on this page, 20 pixels up to 38 levels apart.
+    from PIL import ImageDraw, ImageFont
+
+    from aarecovery.lab.drawings import SERIF_FONT
+    from aarecovery.plan.compression import MIN_NOISE_CONTRAST
+    page = Image.new("RGB", (512, 512), (214, 203, 170))
+    draw = ImageDraw.Draw(page)
+    for line in range(4):
+        draw.text((42, 64 + 102 * line), "the quick fox jumps", font=ImageFont.truetype(SERIF_FONT, 44),
+                  fill=(35, 30, 45))
+    buffer = io.BytesIO()
+    page.resize((128, 128), Image.BOX).save(buffer, format="JPEG", quality=90)
+    original = np.asarray(Image.open(buffer).convert("RGB"))
+    filtered = np.where(original >= 128, 255, 0).astype(np.uint8)
+    actual = aarecovery.recover(original, filtered, engine=gl_engine)
+    assert gl_engine.last_plan.pure_colours.noise_contrast == MIN_NOISE_CONTRAST
     expected = aarecovery.recover(original, filtered, backend="numpy")
     assert np.abs(actual.astype(np.int64) - expected).max() <= 1
 

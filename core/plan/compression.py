@@ -128,8 +128,11 @@ NOISE_CONTRAST_SIGMAS = 7.0
 #: The least contrast a compressed O's extremes need: ringing next to a letter does not shrink
 #: with the noise's deviation as fast as the tables do. At q 95 (1.9 levels, 7 deviations
 #: 13.6 levels) 3 of 8 pages (192 x 192, tinted and textured paper) kept 1-12 darkened
-#: bare-paper pixels; at 20 levels none (nor at 10 deviations).
-MIN_NOISE_CONTRAST = 20.0 / 255
+#: bare-paper pixels; at 20 levels none (nor at 10 deviations). Half a level above, as
+#: ``spec.pure_colours.MIN_CONTRAST``: at exactly 20 levels 8-bit extremes tied with it, and
+#: where the pixels' noise estimate fell to this floor GL and NumPy decided those ties apart
+#: (a thresholded page saved at q 90, 128 x 128: 20 pixels up to 38 levels apart).
+MIN_NOISE_CONTRAST = 20.5 / 255
 #: The share of zero high-frequency coefficients at the best grid phase over that at the
 #: second best, above which the pixels show a block grid (see :func:`detect_block_grid`).
 #: Measured on the real-tools quick suite's analysis windows: PNG originals 0.000-0.055
