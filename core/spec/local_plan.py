@@ -90,7 +90,9 @@ INK_RADIUS = 3
 INK_REPEATS = 3
 INK_NEAR_SPAN = 3.5 / 255
 #: Ink whose brightest channel is at most this is no evidence (a camera's clipped shadows).
-INK_DARK = 5.0 / 255
+#: Half a level above 5, so that no 8-bit colour ties with it: GPUs convert 8-bit texels to
+#: floats differently in the last bit (see INK_TIE), and a tie would decide there.
+INK_DARK = 5.5 / 255
 #: Two colours of a 3 x 3 neighbourhood whose channel sums differ by at most this are equally
 #: bright (or dark): the first in row order is the extreme. A quarter of an 8-bit level, so
 #: that 8-bit colours with equal sums, (233, 231, 236) and (233, 230, 237), tie whatever the
