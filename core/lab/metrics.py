@@ -8,10 +8,11 @@ import numpy as np
 
 from ..colour import LUMA_WEIGHTS
 from ..filters.spatial import gaussian_filter
+from ..spec.local_plan import FLAT_SPAN, neighbourhood_extremes
 from ..spec.sobel import image_gradients
 
 __all__ = ["mse", "psnr", "ssim", "ssim_map", "edge_band", "error_reduction", "outside_local_range", "haze_pixels",
-           "flat_areas", "HAZE_TOLERANCE", "FLAT_AREA_SPAN"]
+           "flat_areas", "HAZE_TOLERANCE"]
 
 # An edge-band pixel is one where the reference and F differ by more than this (they
 # disagree there, so that is where a repair is needed or can harm) ...
@@ -23,9 +24,6 @@ _PSNR_CAP = 100.0
 #: How much darker than F a background pixel may come out before it counts as haze: two
 #: 8-bit steps of luma, above the rounding of any repair but far below a visible blotch.
 HAZE_TOLERANCE = 2.0 / 255
-#: F is flat at a pixel where its 3 x 3 neighbourhood spans at most this in every channel:
-#: equal 8-bit values (a thresholded page's white, a posterized level's fill).
-FLAT_AREA_SPAN = 0.5 / 255
 _LUMA = LUMA_WEIGHTS  # Rec. 709, on encoded values
 
 
@@ -136,20 +134,15 @@ def outside_local_range(image, filtered, slack=1.0 / 255):
 
 def flat_areas(image):
     """bool ``(H, W)``: where `image`'s 3 x 3 neighbourhood (borders replicated) spans at most
-    :data:`FLAT_AREA_SPAN` in every channel: its flat areas, where haze would show.
+    half an 8-bit level in every channel (``spec.local_plan.FLAT_SPAN``, black included): one
+    8-bit colour, a thresholded page's white or a posterized level's fill, where haze would show.
 
     Parameters
     ----------
     image : ndarray of float32, shape (H, W, 3)
     """
-    height, width = image.shape[:2]
-    padded = np.pad(np.asarray(image, np.float32), ((1, 1), (1, 1), (0, 0)), mode="edge")
-    brightest, darkest = padded[1:height + 1, 1:width + 1].copy(), padded[1:height + 1, 1:width + 1].copy()
-    for dy in range(3):
-        for dx in range(3):
-            np.maximum(brightest, padded[dy:dy + height, dx:dx + width], out=brightest)
-            np.minimum(darkest, padded[dy:dy + height, dx:dx + width], out=darkest)
-    return (brightest - darkest).max(axis=-1) <= np.float32(FLAT_AREA_SPAN)
+    brightest, darkest = neighbourhood_extremes(np.asarray(image, np.float32))
+    return (brightest - darkest).max(axis=-1) <= np.float32(FLAT_SPAN)
 
 
 def haze_pixels(image, filtered, background, tolerance=HAZE_TOLERANCE):

@@ -154,6 +154,7 @@ def _target_rows(results, summary):
 # antialias, the joint bilateral filter).
 _HAZE_OTHERS = ("paper", "gimp", "gmic", "jbf")
 
+
 def _region_rows(summary, others, met):
     """The local plan's targets: mixed content per region, neighbourhood filters, haze."""
     rows = []
