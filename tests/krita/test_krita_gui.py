@@ -45,7 +45,7 @@ def gui_run(tmp_path_factory):
         pytest.skip(message)
     root = tmp_path_factory.mktemp("krita-gui")
     data, config, folder = root / "data", root / "config", root / "case"
-    for path in (config, folder):
+    for path in (config, folder, root / "tmp"):
         path.mkdir()
     # Another plug-in's tick already there: the installer must keep it.
     (config / "kritarc").write_text("[python]\nenable_aarecovery_gui_check=true\n")
@@ -60,7 +60,8 @@ def gui_run(tmp_path_factory):
     (folder / "F.raw").write_bytes(encode(threshold(rgba), "U8"))
     (folder / "case.json").write_text(json.dumps({"size": [168, 120]}))
     env = {**os.environ, "XDG_DATA_HOME": str(data), "XDG_CONFIG_HOME": str(config),
-           "AARECOVERY_KRITA_GUI": str(folder)}
+           "AARECOVERY_KRITA_GUI": str(folder),
+           "TMPDIR": str(root / "tmp")}   # Krita leaves a frame-cache folder there
     env.pop("QT_QPA_PLATFORM", None)
     start = time.monotonic()
     # Its own session, so that a hung Krita is killed with xvfb-run (a Krita left running would

@@ -138,7 +138,9 @@ def krita_run(workdir, mode, cases, pykrita, env, screenshot=None):
             if source.exists():
                 shutil.copy(source, run_dir / source.name)
     (run_dir / "cases.json").write_text(json.dumps(chosen))
-    full_env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", "PYTHONPATH": str(HERE),
+    # Krita makes a frame-cache folder in the temporary folder and leaves it there: its own.
+    (run_dir / "tmp").mkdir()
+    full_env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", "PYTHONPATH": str(HERE), "TMPDIR": str(run_dir / "tmp"),
                 "AARECOVERY_KRITA_PYKRITA": str(pykrita), "AARECOVERY_KRITA_CASES": str(run_dir / "cases.json"),
                 **env}
     if screenshot:
