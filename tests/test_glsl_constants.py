@@ -49,6 +49,7 @@ TWINS = {
     ("classify_blocks.comp", "BLOCK_SIDE"): blocks.BLOCK_SIDE,
     ("classify_blocks.frag", "MARGIN"): blocks.MARGIN,
     ("classify_blocks.frag", "BLOCK_SIDE"): blocks.BLOCK_SIDE,
+    ("live_blocks.glsl", "LIVE_BLOCK_SIDE"): blocks.BLOCK_SIDE,
     ("block_lists.glsl", "DRAW_COMMAND_WORDS"): blocks.DRAW_COMMAND_WORDS,
     ("block_lists.glsl", "DISPATCH_COMMAND_WORDS"): blocks.DISPATCH_COMMAND_WORDS,
     ("block_lists.glsl", "LIST_ACTIVE"): blocks.LISTS.index("active"),

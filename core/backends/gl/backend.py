@@ -15,8 +15,9 @@ Passes (each has a NumPy twin of the same name in ``aarecovery.spec.passes``):
 
 Passes 1 and 2 cover only the blocks of 16 x 16 pixels where the edge strength can be
 non-zero (``blocks.py``): where F is not flat for the paper's model, where O is not flat with
-pure colours (whose edge strength does not need F's gradient). Pass 3 covers the other
-blocks. The block lists are made on the GPU when a run first needs them (``classify.py``) and
+pure colours (whose edge strength does not need F's gradient); with pure colours and the
+GPU classification, pass 2 covers only the blocks where pass 1 found that a step can change
+anything (``live_blocks.glsl``). Pass 3 covers the other blocks. The block lists are made on the GPU when a run first needs them (``classify.py``) and
 drive the draws and dispatches indirectly. On llvmpipe, which shades every covered
 fragment, this is what makes mostly flat results (threshold, posterize) fast; on a GPU it
 saves the work of idle lanes.
@@ -69,6 +70,8 @@ _WORK_TEXTURES = {"original_work": (4, "f4"), "filtered_work": (4, "f4"), "model
                   "local_flat": (1, "f4"), "local_rows": (1, "f4"), "strength_factor": (2, "f4"), "strength": (1, "f4"),
                   "jacobi_constant": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4")}
 _RESULT_BITS = {np.dtype(np.uint8): 8, np.dtype(np.uint16): 16}
+# The storage-buffer binding of the fit's live-block flags (live_blocks.glsl).
+_LIVE_FLAGS = 6
 
 #: How a texture of 1 to 4 channels reads as straight RGBA: the texture unit expands grey
 #: and RGB for free, where a CPU expansion to RGBA cost more than the upload itself.
@@ -424,8 +427,16 @@ class GLBackend:
             if active not in self._working_lists:
                 self._to_working_space(lists, "dilated")
                 self._working_lists.add(active)
+            # With pure colours the fit covers O's active blocks, and where the classification
+            # runs on the GPU it flags those whose steps can change anything (live_blocks.glsl):
+            # the steps cover only them. (Over F's blocks nearly all are live: there the flags
+            # and their lists cost more than they spare.)
+            live = (self._live_blocks() if plan.iterations > 0 and active == "original" and self._classifier.compute
+                    else None)
             if plan.iterations > 0 or maps:
-                self._fit_blend_model(sources, uniforms, defines, lists, maps)
+                self._fit_blend_model(sources, uniforms, defines, lists, maps, live)
+            if live is not None:
+                self._timed("live blocks", lambda: self._classifier.list_flagged(*live))
             result = self._textures["result"]
             keep = {"filtered_image": self._textures["filtered"]}
             if self._result_is_filtered_format:
@@ -436,10 +447,11 @@ class GLBackend:
             elif plan.iterations == 0:
                 self._run_pass("keep_filtered", keep, [result], defines=defines)
             else:
-                self._run_pass("keep_filtered", keep, [result], blocks=lists, list_name="inactive",
-                              defines=defines)
+                # F wherever the steps do not write: outside the live blocks when listed.
+                self._run_pass("keep_filtered", keep, [result], blocks=lists if live is None else live[1],
+                              list_name="inactive", defines=defines)
             if plan.iterations > 0:
-                self._jacobi_steps(sources, defines, lists, plan.iterations)
+                self._jacobi_steps(sources, defines, lists if live is None else live[1], plan.iterations)
         self._stage("passes")
         self._ran = {"maps": maps}
 
@@ -504,8 +516,25 @@ class GLBackend:
                     noise_contrast=float(prior.noise_contrast), ridge_noise=float(prior.ridge_noise),
                     luma_purity=float(prior.luma_purity))
 
-    def _fit_blend_model(self, sources, uniforms, defines, lists, maps):
-        """The model and the first Jacobi iterate (and the edge map, the Jacobi steps' constant with pure colours)."""
+    def _live_blocks(self):
+        """The flags the fit sets and the lists made of them (``live_blocks.glsl``), flags cleared."""
+        grid = block_grid(self._key[0])
+        lists = self._lists.get("live")
+        if lists is None or lists.grid != grid:
+            if lists is not None:
+                self._path.forget_blocks(lists)
+                lists.release()
+            lists = self._lists["live"] = BlockLists(self.context, grid)
+        flags = self._pixel_buffers.get("live_flags")
+        if flags is None:
+            # Made with the images (released with them when the tile size changes).
+            flags = self._pixel_buffers["live_flags"] = self.context.buffer(reserve=4 * grid[0] * grid[1])
+        flags.clear()
+        return flags, lists
+
+    def _fit_blend_model(self, sources, uniforms, defines, lists, maps, live=None):
+        """The model and the first Jacobi iterate (and the edge map, the Jacobi steps' constant with pure colours);
+        with `live` (flags, lists), the blocks whose Jacobi steps can change anything flagged."""
         pure = defines["JACOBI_CONSTANT"]
         outputs = [self._work("model"), self._work("iterate_a")]
         if maps:
@@ -517,15 +546,21 @@ class GLBackend:
         if pure:
             outputs.append(self._work("jacobi_constant"))
             locations = dict(CONSTANT_LOCATION=2 + int(maps))
+        if live is not None:
+            live[0].bind_to_storage_buffer(_LIVE_FLAGS)
+            uniforms = {**uniforms, "live_columns": live[1].grid[0]}
         self._run_pass("fit_blend_model", sources, outputs, blocks=lists, list_name="active", uniforms=uniforms,
-                      defines={**defines, "MAPS": int(maps), "SHARED_TILE": int(self.shared_tile), **locations})
+                      defines={**defines, "MAPS": int(maps), "SHARED_TILE": int(self.shared_tile),
+                               "LIVE_BLOCKS": int(live is not None), **locations})
 
     def _jacobi_steps(self, sources, defines, lists, iterations):
         """Iterations 2..n ping-pong between two textures; the last writes the result.
 
         R1 from R0 = F is the fit's first iterate; with one iteration the last pass forms it
-        again, reading F itself. Every value a step gathers lies in an active block (the
-        margin of ``blocks.active_mask``), where the step before wrote it.
+        again, reading F itself. Every value a step gathers lies in a listed block, where the
+        step before wrote it: in an active block (the margin of ``blocks.active_mask``), and
+        with the fit's live blocks in one of those (``live_blocks.glsl`` flags the blocks of
+        both gathers).
         """
         inputs = {**sources, "model_map": self._work("model")}
         if defines["JACOBI_CONSTANT"]:

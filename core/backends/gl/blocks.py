@@ -13,7 +13,7 @@ turns a block mask made on the GPU into lists.
 import numpy as np
 
 __all__ = ["BLOCK_SIDE", "MARGIN", "LISTS", "DRAW_COMMAND_WORDS", "DISPATCH_COMMAND_WORDS", "active_mask",
-           "active_blocks", "block_lists", "expand_runs"]
+           "active_blocks", "block_lists", "expand_runs", "extreme_offsets", "live_mask"]
 
 BLOCK_SIDE = 16
 #: Pixels around a block whose differences still wake it (see :func:`active_mask`).
@@ -74,6 +74,58 @@ def active_mask(pixels, side=BLOCK_SIDE, margin=MARGIN):
         active[max(0, dy):rows + min(0, dy), max(0, dx):columns + min(0, dx)] |= \
             hit[max(0, -dy):rows - max(0, dy), max(0, -dx):columns - max(0, dx)]
     return active
+
+
+def extreme_offsets(code):
+    """The offsets of a pixel's two extremes from the fit's model code (``neighbourhood.glsl``).
+
+    Parameters
+    ----------
+    code : ndarray of float32, shape (H, W)
+        The model's third channel: ``(a.x + 1) + 3 (a.y + 1) + 9 (b.x + 1) + 27 (b.y + 1)``,
+        plus 81 and 162 where extreme a or b is a pure colour (``blend_model.glsl``).
+
+    Returns
+    -------
+    ndarray of int, shape (H, W, 4)
+        ``a.x, a.y, b.x, b.y``, each in -1..1.
+    """
+    digits = np.rint(code).astype(np.int64) % 81
+    return np.stack([digits // 3 ** k % 3 - 1 for k in range(4)], axis=-1)
+
+
+def live_mask(beta, code, changed, fitted, side=BLOCK_SIDE):
+    """Which blocks the Jacobi steps must cover: those the fit flags (``live_blocks.glsl``).
+
+    Where beta is 0 a step gathers nothing and gives its constant, F itself unless the fit
+    moved it (pure colours, towards O): exactly what the result holds before the steps. So
+    the steps need the blocks of the pixels where beta is not 0 or the constant is not F,
+    and, where beta is not 0, the blocks of the two texels the step gathers.
+
+    Parameters
+    ----------
+    beta, code : ndarray of float32, shape (H, W)
+        The fit's model (``model.y``, ``model.z``).
+    changed : ndarray of bool, shape (H, W)
+        Where the fit's constant of the steps differs from F.
+    fitted : ndarray of bool, shape (H, W)
+        The pixels the fit covered (its active blocks): only those flag.
+    side : int
+
+    Returns
+    -------
+    ndarray of bool, shape (ceil(H / side), ceil(W / side))
+    """
+    height, width = beta.shape
+    mask = np.zeros((-(-height // side), -(-width // side)), bool)
+    gathers = fitted & (beta != 0)
+    ys, xs = np.nonzero(fitted & (gathers | changed))
+    mask[ys // side, xs // side] = True
+    ys, xs = np.nonzero(gathers)
+    offsets = extreme_offsets(code[ys, xs])
+    for dx, dy in ((offsets[:, 0], offsets[:, 1]), (offsets[:, 2], offsets[:, 3])):
+        mask[np.clip(ys + dy, 0, height - 1) // side, np.clip(xs + dx, 0, width - 1) // side] = True
+    return mask
 
 
 def _as_list(mask):

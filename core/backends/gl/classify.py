@@ -176,7 +176,26 @@ class BlockClassifier:
         flag["image_size"] = texture.size
         flag["block_grid"] = lists.grid
         flag.run(columns, -(-rows // BLOCK_SIDE))
+        self._compact(lists)
+
+    def list_flagged(self, flags, lists):
+        """Fill `lists` with the blocks a pass flagged in `flags` (GL 4.3; a uint32 per block).
+
+        Its ``"active"`` list holds the flagged blocks, ``"dilated"`` and ``"inactive"`` the
+        same as a classification's (``blocks.block_lists``).
+        """
+        lists.reset()
+        lists.commands.write(_EMPTY_COMMANDS)
+        flags.bind_to_storage_buffer(_FLAGS)
+        lists.commands.bind_to_storage_buffer(_COMMANDS)
+        for offset, name in enumerate(LISTS):
+            lists.buffers[name].bind_to_storage_buffer(_FIRST_LIST + offset)
+        self._compact(lists)
+
+    def _compact(self, lists):
+        """Steps 2 and 3 on the flags bound: the lists and their commands."""
         self.context.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
+        columns, rows = lists.grid
         compact = self._compute_shader("compact_blocks.comp")
         compact["block_grid"] = lists.grid
         compact.run(-(-columns * rows // 64))

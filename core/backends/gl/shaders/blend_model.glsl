@@ -30,6 +30,7 @@ struct BlendFit {
     vec4 jacobi_constant; // with pure colours: (1 - beta) F plus beta's share of the fixed
                           // pure colours (towards O: (1 - beta - g) F + g O for (1 - beta) F),
                           // the part of every Jacobi step that R does not change
+    bool live;            // a Jacobi step here can give other than F (live_blocks.glsl)
 };
 
 // Roweis EM for one component is power iteration on the 4x4 scatter matrix (see the NumPy
@@ -97,6 +98,7 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
         fit.model = vec4(0.5, 0.0, 0.0, 0.0);
         fit.first_iterate = f[0];
         fit.jacobi_constant = f[0];
+        fit.live = false;
         return fit;
     }
 
@@ -191,6 +193,13 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
     fit.jacobi_constant = beta * fixed_share + data;
 #elif TOWARD_ORIGINAL
     fit.jacobi_constant = data;
+#endif
+    // Where beta is 0 a step gathers nothing and gives its constant (or F): F itself unless
+    // towards O or a pure colour moved it.
+#if JACOBI_CONSTANT
+    fit.live = beta != 0.0 || any(notEqual(fit.jacobi_constant, f[0]));
+#else
+    fit.live = beta != 0.0;
 #endif
     return fit;
 }

@@ -31,6 +31,9 @@ vec4 filtered_neighbour(ivec2 p, int i, ivec2 size) {
 #include "pure_colours.glsl"
 #endif
 #include "blend_model.glsl"
+#if LIVE_BLOCKS
+#include "live_blocks.glsl"
+#endif
 
 layout(rgba32f, binding = 0) uniform writeonly image2D model;
 layout(rgba32f, binding = 1) uniform writeonly image2D first_iterate;
@@ -59,6 +62,9 @@ void main() {
     BlendFit fit = fit_blend_model(p, image_size);
     imageStore(model, p, fit.model);
     imageStore(first_iterate, p, fit.first_iterate);
+#if LIVE_BLOCKS
+    flag_live(p, fit, image_size);
+#endif
 #if MAPS
     imageStore(edge_map, p, vec4(fit.edge, 0.0, 0.0, 1.0));
 #endif

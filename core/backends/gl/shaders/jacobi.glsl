@@ -23,16 +23,13 @@ vec4 jacobi_step(ivec2 p, ivec2 size) {
 #endif
     // Most pixels are not edges (beta = 0): they keep F without gathering R.
     if (beta != 0.0) {
-        // The extremes' offsets, two base-3 digits each (see blend_model.glsl), decoded in
-        // float arithmetic: integer division and indexing an array by a variable are
-        // scalar code on a CPU's vector units (llvmpipe).
+        // The extremes' offsets, two base-3 digits each (see blend_model.glsl).
         float code = model.z;
 #if PURE_COLOURS
         float pure = floor((code + 0.5) * (1.0 / 81.0));  // 1: extreme a is a fixed pure colour, 2: b, 3: both
         code -= 81.0 * pure;
 #endif
-        vec4 digits = floor((code + 0.5) / vec4(1.0, 3.0, 9.0, 27.0));
-        vec4 offsets = digits - 3.0 * floor(digits * (1.0 / 3.0)) - 1.0;  // a.x, a.y, b.x, b.y in -1..1
+        vec4 offsets = extreme_offsets(code);  // a.x, a.y, b.x, b.y in -1..1
         vec4 at_a = texelFetch(previous_iterate, clamp_to_image(p + ivec2(offsets.xy), size), 0);
         vec4 at_b = texelFetch(previous_iterate, clamp_to_image(p + ivec2(offsets.zw), size), 0);
 #if PURE_COLOURS
