@@ -2,8 +2,10 @@
 
 Without maps the GL backend runs the local plan's first two passes over the dilated blocks
 and the last over the active ones (``GLBackend._local_factor``); with maps, over the whole
-image, as the strength map reads it. The fit reads the factor only in the active blocks, so
-R must be the same, bit for bit, untiled and tiled, on both paths.
+image, as the strength map reads it. The fit reads the factor only in the active blocks (and,
+without pure colours or a move towards O, only where F varies around the pixel: elsewhere the
+last pass counts no drawn ink), so R must be the same, bit for bit, untiled and tiled, on
+both paths.
 """
 
 import numpy as np
@@ -42,7 +44,7 @@ def test_the_factor_over_the_fitted_blocks_gives_the_whole_images_result(bars_ov
             np.testing.assert_array_equal(tiled, whole, err_msg=f"{name}, tile {tile}")
 
 
-def test_the_factor_is_the_specifications_in_every_active_block(bars_over_photo, gl_path):
+def test_the_factor_is_the_specifications_where_the_fit_reads_it(bars_over_photo, gl_path):
     for name, original, filtered, linear in _pairs(bars_over_photo):
         _, numpy_maps = aarecovery.recover(original, filtered, backend="numpy", linear=linear, return_maps=True)
         with aarecovery.Engine("gl", gl_path=gl_path) as engine:
@@ -58,7 +60,17 @@ def test_the_factor_is_the_specifications_in_every_active_block(bars_over_photo,
         # The region sums reach 8 pixels into the neighbouring blocks: where those hold flat
         # pixels the factor depends on them.
         assert np.abs(numpy_maps.strength[active] - 1).max() > 0.3, name
-        np.testing.assert_allclose(factor[active], numpy_maps.strength[active], atol=_FACTOR_TOLERANCE, err_msg=name)
+        # Where F is flat around a pixel its beta is 0 whatever the factor, which the last
+        # pass then leaves without its drawn ink (FACTOR_FOR_BETA): the fit reads the rest.
+        padded = np.pad(pixels, ((1, 1), (1, 1), (0, 0)), mode="edge")
+        height, width = pixels.shape[:2]
+        varies = np.zeros((height, width), bool)
+        for dy in range(3):
+            for dx in range(3):
+                varies |= (padded[dy:dy + height, dx:dx + width] != pixels).any(axis=-1)
+        read = active & varies
+        assert read.sum() > 100, name
+        np.testing.assert_allclose(factor[read], numpy_maps.strength[read], atol=_FACTOR_TOLERANCE, err_msg=name)
 
 
 def test_equally_bright_extremes_tie_whatever_the_rounding(bars_over_photo):

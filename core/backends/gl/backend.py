@@ -421,7 +421,8 @@ class GLBackend:
                 # Towards O reads the gate too: with the drawn ink where no prior's gate decides.
                 self._local_factor(local_plan, None if maps else (lists, active),
                                    ink_gate=gated or (plan.toward_original and not drawn_only),
-                                   ink_span=prior.ink_span if gated else FLAT_SPAN)
+                                   ink_span=prior.ink_span if gated else FLAT_SPAN,
+                                   for_beta=prior is None and not plan.toward_original)
             if maps:
                 self._strength_map(plan)
             if active not in self._working_lists:
@@ -455,7 +456,7 @@ class GLBackend:
         self._stage("passes")
         self._ran = {"maps": maps}
 
-    def _local_factor(self, local, blocks=None, ink_gate=False, ink_span=FLAT_SPAN):
+    def _local_factor(self, local, blocks=None, ink_gate=False, ink_span=FLAT_SPAN, for_beta=False):
         """The local plan's factor of beta for the loaded O, once per pair and plan (three passes).
 
         `blocks`: ``(lists, name)``, the block lists of the run, when only the fit reads the
@@ -466,22 +467,30 @@ class GLBackend:
         the tiles of the 4096 x 4096 photo pair (llvmpipe), 0.6 s of 1.25-1.8 s now. None:
         the whole image, as the strength map reads it. `ink_gate`: the second channel (the
         gate of pure colours on drawn content only) counts the drawn ink too, recurring within
-        `ink_span` (``PureColourPrior.ink_span``).
+        `ink_span` (``PureColourPrior.ink_span``). `for_beta`: with `blocks`, the factor only
+        multiplies beta (no pure colours, no move towards O): where F is flat around a pixel,
+        whose beta is 0, the last pass counts no drawn ink (``FACTOR_FOR_BETA`` in
+        ``local_plan.glsl``), and the factor there is not the specification's.
         """
-        if self._factor_for in ((local, ink_gate, ink_span, None), (local, ink_gate, ink_span, blocks and blocks[1])):
+        for_beta = bool(for_beta and blocks is not None)
+        if self._factor_for in ((local, ink_gate, ink_span, False, None),
+                                (local, ink_gate, ink_span, for_beta, blocks and blocks[1])):
             return
         defines = {"LOCAL_ENCODE": int(self._linear["original"]), "INK_BY_LUMA": int(ink_gate and ink_span > FLAT_SPAN)}
+        last_inputs = {"local_input": self._work("local_rows"), "original_image": self._textures["original"]}
+        if for_beta:
+            last_inputs["filtered_image"] = self._textures["filtered"]
         steps = (({"original_image": self._textures["original"]}, "local_flat", "dilated"),
                  ({"local_input": self._work("local_flat")}, "local_rows", "dilated"),
-                 ({"local_input": self._work("local_rows"), "original_image": self._textures["original"]},
-                  "strength_factor", "active"))
+                 (last_inputs, "strength_factor", "active"))
         for number, (inputs, output, list_name) in enumerate(steps, 1):
             where = {} if blocks is None else {"blocks": blocks[0], "list_name": list_name}
             uniforms = {"textured": local.textured, "drawn_ink": int(local.drawn_ink), "ink_gate": int(ink_gate),
                         "ink_gate_span": float(ink_span)}
+            beta_only = {"FACTOR_FOR_BETA": int(for_beta)} if number == 3 else {}
             self._run_pass("local_plan", inputs, [self._work(output)], uniforms=uniforms,
-                          defines={**defines, "LOCAL_PASS": number}, **where)
-        self._factor_for = (local, ink_gate, ink_span, blocks and blocks[1])
+                          defines={**defines, **beta_only, "LOCAL_PASS": number}, **where)
+        self._factor_for = (local, ink_gate, ink_span, for_beta, blocks and blocks[1])
 
     def _strength_map(self, plan):
         """The strength map of the maps: the plan's strength times the local factor (read back)."""

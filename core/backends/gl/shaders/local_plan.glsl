@@ -3,7 +3,9 @@
 // columns, the region's flat share, the pixel's drawn ink (read from O) and the factor.
 // Twin: flat_pixels, flat_share, hard_edged_weight, ink_weight and LocalStrength.factor in
 // aarecovery/spec/local_plan.py. With
-// LOCAL_ENCODE the uploaded O is linear light and is sRGB-encoded first. Needs colour.glsl.
+// LOCAL_ENCODE the uploaded O is linear light and is sRGB-encoded first. With
+// FACTOR_FOR_BETA, pass 3 counts no drawn ink where F is flat around the pixel (below).
+// Needs colour.glsl.
 
 const float FLAT_SPAN = 0.5 / 255.0;
 const int REGION_RADIUS = 8;
@@ -29,6 +31,9 @@ uniform float textured;            // the factor in textured regions (pass 3)
 uniform int drawn_ink;             // 1: drawn ink counts as hard-edged too (pass 3)
 uniform int ink_gate;              // 1: drawn ink opens the gate of pure colours too (pass 3)
 uniform float ink_gate_span;       // within what the gate's ink recurs: FLAT_SPAN, wider on a JPEG (pass 3)
+#if FACTOR_FOR_BETA
+uniform sampler2D filtered_image;  // F as uploaded (pass 3)
+#endif
 
 vec3 original_encoded(ivec2 p, ivec2 size) {
     vec3 c = texelFetch(original_image, clamp(p, ivec2(0), size - 1), 0).rgb;
@@ -46,7 +51,7 @@ vec3 original_encoded(ivec2 p, ivec2 size) {
 // neither saturated nor dark (local_plan.py: INK_LUMA_SATURATION). A define, not a test of
 // the span: llvmpipe ran the luma arithmetic for every texel, and pass 3 took 1.5 times as
 // long on a PNG photo.
-vec2 ink_weight(ivec2 p, ivec2 size) {
+vec2 ink_weight(ivec2 p, ivec2 size, bool needed) {
     vec3 brightest = vec3(0.0);
     vec3 darkest = vec3(0.0);
     float high = -1.0;
@@ -72,7 +77,9 @@ vec2 ink_weight(ivec2 p, ivec2 size) {
     ivec2 near = ivec2(0);
     ivec2 gate_equal = ivec2(0);
     ivec2 gate_near = ivec2(0);
-    for (int dy = -INK_RADIUS; dy <= INK_RADIUS; ++dy) {
+    // Not needed: the loop ends at once (a test around it would still run it under a mask on
+    // llvmpipe; a loop whose lanes have all left ends).
+    for (int dy = -INK_RADIUS; dy <= INK_RADIUS && needed; ++dy) {
         for (int dx = -INK_RADIUS; dx <= INK_RADIUS; ++dx) {
             ivec2 q = p + ivec2(dx, dy);
             if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;  // not there
@@ -154,8 +161,24 @@ vec2 local_plan(ivec2 p, ivec2 size) {
     float inside = float((high.x - low.x + 1) * (high.y - low.y + 1));
     float t = clamp((count / inside - TEXTURED_SHARE) / (HARD_EDGED_SHARE - TEXTURED_SHARE), 0.0, 1.0);
     float region = t * t * (3.0 - 2.0 * t);
+    bool needed = true;
+#if FACTOR_FOR_BETA
+    // The factor only multiplies beta (no pure colours' gate, nor towards O, read it), and
+    // where F is flat around the pixel its edge strength, and so beta, is exactly 0: the ink
+    // there changes nothing, and its 49 texels are not read (the factor there is not the
+    // specification's; nothing reads it). Equal uploaded texels are equal working values.
+    vec4 filtered_here = texelFetch(filtered_image, p, 0);
+    bool filtered_flat = true;
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            vec4 neighbour = texelFetch(filtered_image, clamp(p + ivec2(dx, dy), ivec2(0), size - 1), 0);
+            filtered_flat = filtered_flat && all(equal(neighbour, filtered_here));
+        }
+    }
+    needed = !filtered_flat;
+#endif
     // The ink is at most 1: at a full region weight it changes neither value.
-    vec2 ink = (drawn_ink != 0 || ink_gate != 0) && region < 1.0 ? ink_weight(p, size) : vec2(0.0);
+    vec2 ink = (drawn_ink != 0 || ink_gate != 0) && region < 1.0 ? ink_weight(p, size, needed) : vec2(0.0);
     float weight = drawn_ink != 0 ? max(region, ink.x) : region;
     float gate = ink_gate != 0 ? max(region, ink.y) : region;
     return vec2(textured + (1.0 - textured) * weight, gate);
