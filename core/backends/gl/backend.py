@@ -17,8 +17,9 @@ Passes 1 and 2 cover only the blocks of 16 x 16 pixels where the edge strength c
 non-zero (``blocks.py``): where F is not flat for the paper's model, where O is not flat with
 pure colours (whose edge strength does not need F's gradient); with pure colours and the
 GPU classification, pass 2 covers only the blocks where pass 1 found that a step can change
-anything (``live_blocks.glsl``). Pass 3 covers the other blocks. The block lists are made on the GPU when a run first needs them (``classify.py``) and
-drive the draws and dispatches indirectly. On llvmpipe, which shades every covered
+anything (``live_blocks.glsl``). Pass 3 covers the other blocks. The block lists are made
+on the GPU when a run first needs them (``classify.py``) and drive the draws and
+dispatches indirectly. On llvmpipe, which shades every covered
 fragment, this is what makes mostly flat results (threshold, posterize) fast; on a GPU it
 saves the work of idle lanes.
 
