@@ -3,7 +3,7 @@
 // gathers (beta != 0), the blocks of the two texels it gathers, so that every value a
 // listed pixel reads was written by the step before. A step at any other pixel gives
 // exactly F, which the result already holds, so its block is skipped: with pure colours the
-// fit covers O's active blocks, about twice F's, and few of those beyond F's end changed.
+// fit covers O's active blocks, about twice F's, and few of O's blocks outside F's change.
 // Needs neighbourhood.glsl first; the flags are compacted into lists by compact_blocks.comp.
 layout(std430, binding = 6) buffer LiveFlags { uint live_flags[]; };
 uniform int live_columns;  // blocks across the image
