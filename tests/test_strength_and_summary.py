@@ -160,10 +160,23 @@ def test_the_force_is_offered_only_where_the_calibration_saw_it_help(errors, hel
 
 
 def test_an_unsharp_masked_photo_is_not_offered_the_force():
-    """The issue's portrait: forced to full strength, its irises went grey with pale halos."""
+    """The issue's portrait: forced to full strength, its irises went grey with pale halos.
+    It is repaired at a photo's low strength, and nothing offers more."""
     from aarecovery.lab import scenes as _scenes
     from aarecovery.lab.groundtruth import make_case
     case = make_case(_scenes.render("astronaut", 64, 4), "unsharp", 4, "linear")
+    with aarecovery.Engine("numpy") as engine:
+        recovered = aarecovery.recover(case.original, case.filtered, engine=engine)
+        summary = aarecovery.summarize_recovery(engine.last_plan, case.original, case.filtered, recovered)
+    assert summary.decision == Decision.NEIGHBOURHOOD_SHARPENED
+    line = summary.line(force="--strength 1")
+    assert "--strength 1" not in line and "strength 0.1," in line, line
+
+
+def test_a_smoothed_photo_says_what_forcing_risks():
+    from aarecovery.lab import scenes as _scenes
+    from aarecovery.lab.groundtruth import make_case
+    case = make_case(_scenes.render("astronaut", 64, 4), "bilateral", 4, "linear")
     with aarecovery.Engine("numpy") as engine:
         recovered = aarecovery.recover(case.original, case.filtered, engine=engine)
         summary = aarecovery.summarize_recovery(engine.last_plan, case.original, case.filtered, recovered)

@@ -47,12 +47,13 @@ class Decision(str, enum.Enum):
     drawings over the photo: the local plan, ``aarecovery.spec.local_plan``)."""
     NEIGHBOURHOOD_TEXTURED_KEPT = "neighbourhood-textured-kept"
     """A filter that is neither point-wise nor a colour map, on a textured image: F is kept."""
-    NEIGHBOURHOOD_GREY_SHARPENED = "neighbourhood-grey-sharpened"
-    """A sharpening filter (an unsharp mask) on a grey photo: a quarter strength. Every grey
-    3 x 3 neighbourhood lies on one colour line, so the model flattens no colour texture."""
+    NEIGHBOURHOOD_SHARPENED = "neighbourhood-sharpened"
+    """A sharpening filter (an unsharp mask) on a textured image: a quarter strength, which
+    repairs part of the mask's damage without flattening the texture into two colours."""
     NEIGHBOURHOOD_MIXED = "neighbourhood-mixed"
     """The same on a photo with text or drawings over part of it: the drawn regions are
-    repaired, F is kept in the photo (the local plan with a textured strength of 0)."""
+    repaired, F is kept in the photo (the local plan with a textured strength of 0), or under
+    a sharpening filter repaired at a quarter strength."""
     COLOUR_MAP_KEPT = "colour-map-kept"
     """A colour map on a textured image whose repairs would be no larger than the model's
     own error: F is kept."""

@@ -39,8 +39,8 @@ colour lines better), then takes the first of these exits that applies, each nam
    (``mixed_content``): the same where text or drawings cover part of the photo: they are
    repaired as step 10 would (0.75 under a smoothing filter; pure colours where the filter
    keeps flat colours, in the drawn regions only), F kept in the photo (the local plan with
-   a textured strength of 0). ``NEIGHBOURHOOD_GREY_SHARPENED``: a sharpening filter on a
-   grey photo, whose neighbourhoods all lie on one colour line: a lower strength.
+   a textured strength of 0, or under a sharpening filter the lower strength that follows).
+   ``NEIGHBOURHOOD_SHARPENED``: a sharpening filter on a textured image: a lower strength.
 7. ``COLOUR_MAP_KEPT``: a colour map on a textured image whose repairs are no larger than
    the model's own error carried through the filter (``model_error``): F is kept.
 8. ``COLOUR_MAP_CALIBRATED``: a colour map (a palette quantiser) on a textured image: the
@@ -109,19 +109,38 @@ _ANALYSIS_SIDE = 512
 # method lost up to 3.4 dB there (unsharp mask, colour replacement) and gained at most 1 dB
 # (bilateral); no strength was safe for all, so F is kept.
 _PHOTO_NEIGHBOURHOOD_STRENGTH = 0.0
-# ... but a grey photo under a sharpening filter (F's Laplacian at O's edges at least
-# smoothing.SMOOTHED_CONTRAST times O's): every grey neighbourhood lies on one colour line,
-# so the model flattens no colour texture there, and a lower strength repairs part of the
-# mask's damage. Tuning half, the grey photos (handwriting, portrait) under GEGL's and
+# ... but a textured image under a sharpening filter (F's Laplacian at O's edges at least
+# smoothing.SMOOTHED_CONTRAST times O's) is repaired at a low strength, which repairs part of
+# the mask's damage without flattening the texture into the model's two colours.
+# A grey photo: every grey neighbourhood lies on one colour line, so the model flattens no
+# colour texture there. Tuning half, the grey photos (handwriting, portrait) under GEGL's and
 # ImageMagick's unsharp masks, PNG and JPEG (8 cases, kept F before), mean edge-band error
 # reduction by strength: 0.25 0.26 (every case 0.10-0.52), 0.5 0.32, 0.75 0.30, 1 0.21 (the
-# portrait down to 0.08); the colour photos lose at 1 (coffee -0.96 to -1.11, hubble -0.34 to
-# -1.14) and keep F; under smoothing filters the grey portrait loses too (-0.14 to -0.19).
-# A grey image cannot tell its blend space (the model blends in linear light): a photo
-# downscaled in sRGB values, as most resizers do, lost at 0.5 (the built-in photos in grey
-# under the built-in unsharp mask: chelsea -1.8 to -2.1 dB, coffee -0.3) and gains at 0.25
-# (+0.5 to +1.9 dB), so the lower strength.
-_GREY_SHARPENED_STRENGTH = 0.25
+# portrait down to 0.08). A grey image cannot tell its blend space (the model blends in
+# linear light): a photo downscaled in sRGB values, as most resizers do, lost at 0.5 (the
+# built-in photos in grey under the built-in unsharp mask: chelsea -1.8 to -2.1 dB, coffee
+# -0.3) and gains at 0.25 (+0.5 to +1.9 dB), so the lower strength.
+_SHARPENED_GREY_STRENGTH = 0.25
+# A colour photo cannot tell its blend space either (its colour lines fit both alike:
+# plan/blend_space.py), and there the model in the wrong space flattens colour texture.
+# Colour photos lose at 1 (tuning half: coffee -0.96 to -1.11, hubble -0.34 to -1.14); the
+# built-in photos (astronaut, coffee, chelsea) at 64-256 px under the built-in unsharp mask,
+# by strength 0.1 / 0.15 / 0.25, gain +0.27 to +2.01 / -0.35 to +1.77 / -2.94 to +2.14 dB:
+# antialiased in linear light every strength gains, downscaled in sRGB values coffee loses
+# 0.38-0.73 dB at 0.25 (its grey twin gains 0.18-0.96 there) and chelsea at 256 px 0.35 at
+# 0.15. Tuning half, the 27 colour cases under those masks that kept F (photos, the poster
+# and screenshot read as photos or with their photo regions kept, and JPEG drawings whose
+# noise reads as grain: maps, icons, star burst, memo): by strength 0.1 / 0.15 / 0.25 every
+# case gains but one at 0.25 (the icons at q 75, -0.02 dB), mean +0.81 / +0.96 / +1.10 dB.
+# Chelsea downscaled in sRGB values at 384 px loses at every strength (-0.41 dB at 0.1, its
+# grey twin -2.74 at 0.25), where F is within 53 dB of the reference: the filter commutes
+# with a downscale in the values it works in, and leaves nothing to repair.
+_SHARPENED_COLOUR_STRENGTH = 0.1
+
+
+def _sharpened_strength(grey):
+    """The strength for a textured image (or a photo's regions) under a sharpening filter."""
+    return _SHARPENED_GREY_STRENGTH if grey else _SHARPENED_COLOUR_STRENGTH
 # The reasons' note of a smoothing filter's untouched edges (plan/smoothing.py).
 _UNTOUCHED = ", F kept where it left O's edges as they were"
 # ... and of the drawn content's edges moved towards O (Plan.toward_original).
@@ -392,11 +411,17 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
             # drawing would be, F kept in the photo: tuning half, the mixed scenes under the
             # five neighbourhood filters, text and graphics 0 -> 0.15-0.32 of their edge
             # error removed, the photo regions -0.009 to +0.02 (within 0.04 dB of F).
+            # Under a sharpening filter the photo takes the lower strength a textured image
+            # takes there (below): tuning half, the poster and screenshot under the two unsharp
+            # masks (PNG), 0.18-0.44 -> 0.28-0.56 of the edge error, photo regions worse than F
+            # (every filter) 4 -> 2 and their mean 0.211 -> 0.244, text and graphics 0.484 -> 0.490.
+            sharpening = contrast_ratio(o, f, edges)
+            smoothing = sharpening < SMOOTHED_CONTRAST
+            photo_strength = 0.0 if smoothing else _sharpened_strength(grey)
             drawn = drawn_share(o, edges)
             if drawn >= MIXED_DRAWN_SHARE:
                 ratio = _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e)
                 if ratio >= MIN_REPAIR_TO_ERROR:
-                    smoothing = contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST
                     strength = SMOOTHED_STRENGTH if smoothing else 1.0
                     # Where the filter keeps flat colours, thin features in the drawn regions
                     # get their pure colours (plan/flat_colours.py), by the regions' weight as
@@ -422,18 +447,19 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                     pure = f", pure colours of thin features there ({kept})" if prior is not None else ""
                     return PairAnalysis(space, strength,
                                         f"neighbourhood filter on a textured image ({texture}) with text or drawings "
-                                        f"over it ({drawn:.2f} of the edges): strength {strength:g} there{pure}, F "
-                                        "kept in the rest" + (_UNTOUCHED if smoothing else "")
+                                        f"over it ({drawn:.2f} of the edges): strength {strength:g} there{pure}, "
+                                        + (f"strength {photo_strength:g} in the rest" if photo_strength else "F kept in the rest")
+                                        + (_UNTOUCHED if smoothing else "")
                                         + (_TOWARD if toward else ""),
-                                        Decision.NEIGHBOURHOOD_MIXED, prior, local=LocalStrength(0.0),
+                                        Decision.NEIGHBOURHOOD_MIXED, prior, local=LocalStrength(photo_strength),
                                         untouched_span=UNTOUCHED_SPAN if smoothing else 0.0,
                                         toward_original=toward)
-            sharpening = contrast_ratio(o, f, edges)
-            if grey and sharpening >= SMOOTHED_CONTRAST:
-                return PairAnalysis(space, _GREY_SHARPENED_STRENGTH,
-                                    f"sharpening filter on a grey photo ({texture}; F's edge contrast "
-                                    f"{sharpening:.2f} times O's): strength {_GREY_SHARPENED_STRENGTH:g}",
-                                    Decision.NEIGHBOURHOOD_GREY_SHARPENED)
+            if not smoothing:
+                strength = _sharpened_strength(grey)
+                return PairAnalysis(space, strength,
+                                    f"sharpening filter on a textured image ({texture}; F's edge contrast "
+                                    f"{sharpening:.2f} times O's): strength {strength:g}",
+                                    Decision.NEIGHBOURHOOD_SHARPENED)
             return PairAnalysis(space, _PHOTO_NEIGHBOURHOOD_STRENGTH,
                                 f"neighbourhood filter on a textured image ({texture}): "
                                 f"strength {_PHOTO_NEIGHBOURHOOD_STRENGTH:g}", Decision.NEIGHBOURHOOD_TEXTURED_KEPT,
