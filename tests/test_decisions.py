@@ -83,7 +83,7 @@ PAIRS = {
     Decision.POINTWISE_HARD_EDGED: lambda: _case("shapes", "posterize"),
     Decision.POINTWISE_CALIBRATED: lambda: _case("astronaut", "posterize"),
     Decision.NEIGHBOURHOOD_TEXTURED_KEPT: lambda: _case("astronaut", "bilateral"),
-    Decision.NEIGHBOURHOOD_SHARPENED: lambda: _grey_photo("unsharp"),
+    Decision.NEIGHBOURHOOD_TEXTURED: lambda: _grey_photo("unsharp"),
     Decision.NEIGHBOURHOOD_MIXED: lambda: (_drawing("poster"), aarecovery.filters.apply("unsharp", _drawing("poster"))),
     Decision.COLOUR_MAP_KEPT: lambda: (_drawing("maps"), _saturate(_drawing("maps"), 1.5)),
     Decision.COLOUR_MAP_CALIBRATED: _quantised_photo,

@@ -168,7 +168,7 @@ def test_an_unsharp_masked_photo_is_not_offered_the_force():
     with aarecovery.Engine("numpy") as engine:
         recovered = aarecovery.recover(case.original, case.filtered, engine=engine)
         summary = aarecovery.summarize_recovery(engine.last_plan, case.original, case.filtered, recovered)
-    assert summary.decision == Decision.NEIGHBOURHOOD_SHARPENED
+    assert summary.decision == Decision.NEIGHBOURHOOD_TEXTURED
     line = summary.line(force="--strength 1")
     assert "--strength 1" not in line and "strength 0.1," in line, line
 

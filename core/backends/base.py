@@ -47,9 +47,10 @@ class Decision(str, enum.Enum):
     drawings over the photo: the local plan, ``aarecovery.spec.local_plan``)."""
     NEIGHBOURHOOD_TEXTURED_KEPT = "neighbourhood-textured-kept"
     """A filter that is neither point-wise nor a colour map, on a textured image: F is kept."""
-    NEIGHBOURHOOD_SHARPENED = "neighbourhood-sharpened"
-    """A sharpening filter (an unsharp mask) on a textured image: a quarter strength, which
-    repairs part of the mask's damage without flattening the texture into two colours."""
+    NEIGHBOURHOOD_TEXTURED = "neighbourhood-textured"
+    """A neighbourhood filter on a grey textured image, or a sharpening filter (an unsharp
+    mask) on a colour one: a low strength, which repairs part of the filter's damage without
+    flattening the texture into two colours."""
     NEIGHBOURHOOD_MIXED = "neighbourhood-mixed"
     """The same on a photo with text or drawings over part of it: the drawn regions are
     repaired, F is kept in the photo (the local plan with a textured strength of 0), or under

@@ -39,8 +39,9 @@ colour lines better), then takes the first of these exits that applies, each nam
    (``mixed_content``): the same where text or drawings cover part of the photo: they are
    repaired as step 10 would (0.75 under a smoothing filter; pure colours where the filter
    keeps flat colours, in the drawn regions only), F kept in the photo (the local plan with
-   a textured strength of 0, or under a sharpening filter the lower strength that follows).
-   ``NEIGHBOURHOOD_SHARPENED``: a sharpening filter on a textured image: a lower strength.
+   a textured strength of 0, or under a sharpening filter the low strength that follows).
+   ``NEIGHBOURHOOD_TEXTURED``: a grey textured image under any such filter, or a colour one
+   under a sharpening filter: a low strength.
 7. ``COLOUR_MAP_KEPT``: a colour map on a textured image whose repairs are no larger than
    the model's own error carried through the filter (``model_error``): F is kept.
 8. ``COLOUR_MAP_CALIBRATED``: a colour map (a palette quantiser) on a textured image: the
@@ -107,11 +108,12 @@ __all__ = ["PairAnalysis", "analyse", "analyse_pair", "analysis_crop"]
 _ANALYSIS_SIDE = 512
 # Strength for neighbourhood (not point-wise, not low-pass) filters on photos: the paper's
 # method lost up to 3.4 dB there (unsharp mask, colour replacement) and gained at most 1 dB
-# (bilateral); no strength was safe for all, so F is kept.
+# (bilateral); no strength was safe for all, so a colour photo under a smoothing filter keeps F.
 _PHOTO_NEIGHBOURHOOD_STRENGTH = 0.0
-# ... but a textured image under a sharpening filter (F's Laplacian at O's edges at least
-# smoothing.SMOOTHED_CONTRAST times O's) is repaired at a low strength, which repairs part of
-# the mask's damage without flattening the texture into the model's two colours.
+# ... but a grey photo under any neighbourhood filter, and a colour one under a sharpening
+# filter (F's Laplacian at O's edges at least smoothing.SMOOTHED_CONTRAST times O's), is
+# repaired at a low strength, which repairs part of the filter's damage without flattening
+# the texture into the model's two colours.
 # A grey photo: every grey neighbourhood lies on one colour line, so the model flattens no
 # colour texture there. Tuning half, the grey photos (handwriting, portrait) under GEGL's and
 # ImageMagick's unsharp masks, PNG and JPEG (8 cases, kept F before), mean edge-band error
@@ -119,8 +121,13 @@ _PHOTO_NEIGHBOURHOOD_STRENGTH = 0.0
 # portrait down to 0.08). A grey image cannot tell its blend space (the model blends in
 # linear light): a photo downscaled in sRGB values, as most resizers do, lost at 0.5 (the
 # built-in photos in grey under the built-in unsharp mask: chelsea -1.8 to -2.1 dB, coffee
-# -0.3) and gains at 0.25 (+0.5 to +1.9 dB), so the lower strength.
-_SHARPENED_GREY_STRENGTH = 0.25
+# -0.3) and gains at 0.25 (+0.5 to +1.9 dB), so the lower strength. Under smoothing filters
+# the portrait lost at 1 (-0.14 to -0.19) and gains at 0.25: tuning half, the two grey photos
+# under the three smoothing filters, PNG and JPEG (12 cases, F kept before), 11 up (0.03-0.27,
+# up to 1.39 dB) and one down by 0.04 dB (the handwriting under OpenCV's bilateral at q 75);
+# the built-in photos in grey at 64-256 px under the built-in bilateral filter, both spaces,
+# +0.73 to +1.99 dB (+0.35 to +0.90 at 0.1).
+_GREY_TEXTURED_STRENGTH = 0.25
 # A colour photo cannot tell its blend space either (its colour lines fit both alike:
 # plan/blend_space.py), and there the model in the wrong space flattens colour texture.
 # Colour photos lose at 1 (tuning half: coffee -0.96 to -1.11, hubble -0.34 to -1.14); the
@@ -134,13 +141,20 @@ _SHARPENED_GREY_STRENGTH = 0.25
 # case gains but one at 0.25 (the icons at q 75, -0.02 dB), mean +0.81 / +0.96 / +1.10 dB.
 # Chelsea downscaled in sRGB values at 384 px loses at every strength (-0.41 dB at 0.1, its
 # grey twin -2.74 at 0.25), where F is within 53 dB of the reference: the filter commutes
-# with a downscale in the values it works in, and leaves nothing to repair.
+# with a downscale in the values it works in, and leaves nothing to repair. Under smoothing
+# filters colour photos lose even at 0.1 (tuning half: hubble under GEGL's hue-chroma -0.13,
+# coffee under OpenCV's bilateral at q 95 -0.01) and keep F.
 _SHARPENED_COLOUR_STRENGTH = 0.1
 
 
-def _sharpened_strength(grey):
-    """The strength for a textured image (or a photo's regions) under a sharpening filter."""
-    return _SHARPENED_GREY_STRENGTH if grey else _SHARPENED_COLOUR_STRENGTH
+def _textured_strength(grey, smoothing):
+    """The strength for a textured image (or a photo's regions) under a neighbourhood filter
+    that is no colour map: 0 keeps F."""
+    if grey:
+        return _GREY_TEXTURED_STRENGTH
+    return _PHOTO_NEIGHBOURHOOD_STRENGTH if smoothing else _SHARPENED_COLOUR_STRENGTH
+
+
 # The reasons' note of a smoothing filter's untouched edges (plan/smoothing.py).
 _UNTOUCHED = ", F kept where it left O's edges as they were"
 # ... and of the drawn content's edges moved towards O (Plan.toward_original).
@@ -423,7 +437,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
             # (every filter) 4 -> 2 and their mean 0.211 -> 0.244, text and graphics 0.484 -> 0.490.
             sharpening = contrast_ratio(o, f, edges)
             smoothing = sharpening < SMOOTHED_CONTRAST
-            photo_strength = 0.0 if smoothing else _sharpened_strength(grey)
+            photo_strength = 0.0 if smoothing else _textured_strength(grey, smoothing)
             drawn = drawn_share(o, edges)
             if drawn >= MIXED_DRAWN_SHARE:
                 ratio = _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e)
@@ -460,15 +474,16 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                         Decision.NEIGHBOURHOOD_MIXED, prior, local=LocalStrength(photo_strength),
                                         untouched_span=UNTOUCHED_SPAN if smoothing else 0.0,
                                         toward_original=toward)
-            if not smoothing:
-                strength = _sharpened_strength(grey)
+            strength = _textured_strength(grey, smoothing)
+            if strength > 0:
                 return PairAnalysis(space, strength,
-                                    f"sharpening filter on a textured image ({texture}; F's edge contrast "
+                                    f"{'smoothing' if smoothing else 'sharpening'} filter on a "
+                                    f"{'grey ' if grey else ''}textured image ({texture}; F's edge contrast "
                                     f"{sharpening:.2f} times O's): strength {strength:g}",
-                                    Decision.NEIGHBOURHOOD_SHARPENED)
-            return PairAnalysis(space, _PHOTO_NEIGHBOURHOOD_STRENGTH,
+                                    Decision.NEIGHBOURHOOD_TEXTURED)
+            return PairAnalysis(space, strength,
                                 f"neighbourhood filter on a textured image ({texture}): "
-                                f"strength {_PHOTO_NEIGHBOURHOOD_STRENGTH:g}", Decision.NEIGHBOURHOOD_TEXTURED_KEPT,
+                                f"strength {strength:g}", Decision.NEIGHBOURHOOD_TEXTURED_KEPT,
                                 forcing=forcing_advice(Decision.NEIGHBOURHOOD_TEXTURED_KEPT))
         # A colour map that bends colours smoothly (a hue change) leaves repairs no larger
         # than the model's error; calibration alone chose 0.5 there and lost 0.73 dB (GEGL's
