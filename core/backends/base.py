@@ -54,7 +54,7 @@ class Decision(str, enum.Enum):
     NEIGHBOURHOOD_MIXED = "neighbourhood-mixed"
     """The same on a photo with text or drawings over part of it: the drawn regions are
     repaired, F is kept in the photo (the local plan with a textured strength of 0), or under
-    a sharpening filter repaired at a quarter strength."""
+    a sharpening filter repaired at a photo's low strength (0.25 grey, 0.1 in colour)."""
     COLOUR_MAP_KEPT = "colour-map-kept"
     """A colour map on a textured image whose repairs would be no larger than the model's
     own error: F is kept."""

@@ -437,7 +437,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
             # (every filter) 4 -> 2 and their mean 0.211 -> 0.244, text and graphics 0.484 -> 0.490.
             sharpening = contrast_ratio(o, f, edges)
             smoothing = sharpening < SMOOTHED_CONTRAST
-            photo_strength = 0.0 if smoothing else _textured_strength(grey, smoothing)
+            photo_strength = 0.0 if smoothing else _textured_strength(grey, smoothing=False)
             drawn = drawn_share(o, edges)
             if drawn >= MIXED_DRAWN_SHARE:
                 ratio = _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e)
