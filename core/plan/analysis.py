@@ -393,6 +393,15 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # graphics 0.414 -> 0.446; per case -0.072 (the poster under G'MIC's pow 3) to +0.180;
         # the grey camera photo and text page (excluded) and no other case moved by over 0.01.
         # On a JPEG the drawn ink recurs within the compression noise (COMPRESSED_INK_SPAN).
+        # Measured and not taken: that span (and q 95's noise as the prior's guards, shift keys
+        # left as they are) for a colour O with no compression evidence too. Tuning half, 920
+        # cases: 63 up, 2 down (the PNG mixed scenes under Pillow's YCbCr equalization 0.617 ->
+        # 0.338 and 0.436 -> 0.346); colour photos under point-wise filters, PNG, 0.295 -> 0.310
+        # (each case +0.01 to +0.07), mixed text and graphics 0.556 -> 0.577, and the maps as q 98
+        # JPEGs, whose grid the 96 px windows do not show, +0.07 to +0.28. But the gate opens on
+        # half the edge pixels of a photo (rocket and chelsea 0.70-0.77, the bench's photo-like
+        # pair 0.49), so the pure colours' passes run over all of O's blocks: that pair's tiles
+        # took 4-5 times as long (2.1 -> 8-11 s on llvmpipe), for a hundredth of the edge error.
         prior = drawn_only(pure_colour_prior(o, transfer, space, f, edges, noise_contrast=compression.contrast,
                                              extend_ends=not compression.compressed, ridge_noise=compression.contrast,
                                              luma_purity=COMPRESSED_LUMA_PURITY if compression.compressed else 0.0),
