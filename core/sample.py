@@ -70,12 +70,15 @@ def analysis_windows(height, width):
 def _edge_pixels(region):
     values = region if region.ndim == 2 else region[..., 0] if region.shape[2] <= 2 else region[..., :3]
     scale = np.float32(1 / np.iinfo(values.dtype).max) if values.dtype.kind in "ui" else np.float32(1)
-    light = values.astype(np.float32) * scale
+    # The same values as astype(float32) * scale, np.diff and a sum of the flags, in fewer
+    # passes over the window: the 65 windows of a 4096 x 4096 photo 0.12 -> 0.09 s on a slow
+    # 2-core machine (tests/test_exact_speedups.py).
+    light = np.multiply(values, scale, dtype=np.float32)
     if light.ndim == 3:
         light = luma(light)
-    across = np.abs(np.diff(light, axis=1)) > _EDGE_STEP
-    down = np.abs(np.diff(light, axis=0)) > _EDGE_STEP
-    return int(across.sum()) + int(down.sum())
+    across = np.abs(np.subtract(light[:, 1:], light[:, :-1])) > _EDGE_STEP
+    down = np.abs(np.subtract(light[1:], light[:-1])) > _EDGE_STEP
+    return int(np.count_nonzero(across)) + int(np.count_nonzero(down))
 
 
 def analysis_sample(read_original, read_filtered, height, width):

@@ -54,6 +54,47 @@ def test_the_grid_search_dcts_and_busy_blocks_are_the_direct_ones(quality):
             np.testing.assert_array_equal(compression._busy(direct), busy)
 
 
+def _grid_search_over_every_block(luma):
+    """The grid search's shares as it computed them before it skipped the blocks that cannot be busy."""
+    shares = np.full((compression.BLOCK, compression.BLOCK), -1.0)
+    for row in range(compression.BLOCK):
+        shared = compression._column_transforms(luma, row)
+        for column in range(compression.BLOCK):
+            coefficients = compression._block_dct(luma, row, column, shared)
+            busy = compression._busy(coefficients)
+            if busy.sum() >= compression._MIN_BUSY_BLOCKS:
+                shares[row, column] = float((np.abs(coefficients[busy][:, 3:, 3:])
+                                             < compression._ZERO_COEFFICIENT).mean())
+    return shares
+
+
+@pytest.mark.parametrize("quality", [None, 75, 95])
+def test_the_grid_search_skips_only_blocks_that_are_not_busy(quality):
+    luma = _jpeg_luma(quality) if quality else scan_page(2, 75)[0][5:, 3:].astype(np.float64) @ np.array(REC601_LUMA)
+    sums, squares = compression._summed_areas(luma)
+    skipped = 0
+    for row in range(compression.BLOCK):
+        for column in range(compression.BLOCK):
+            every = compression._block_dct(luma, row, column)
+            candidates = compression._may_be_busy(sums, squares, row, column)
+            assert candidates.size == len(every)
+            np.testing.assert_array_equal(compression._block_dct(luma, row, column, only=candidates),
+                                          every[candidates.ravel()])
+            busy = compression._busy(every)
+            assert not (busy & ~candidates.ravel()).any()
+            skipped += int((~candidates).sum())
+    assert skipped > 0
+    # The whole search: the same shares, so the same phase and margin (and the table, measured
+    # at that phase from every block).
+    encoded = np.repeat((luma / 255.0)[..., None], 3, axis=-1).astype(np.float32)
+    phase, margin, _ = compression.detect_block_grid(encoded)
+    shares = _grid_search_over_every_block(compression._luma(encoded))
+    assert shares.max() >= 0
+    order = np.argsort(shares.ravel())
+    assert phase == tuple(int(i) for i in np.unravel_index(order[-1], shares.shape))
+    assert margin == float(shares.ravel()[order[-1]] - max(shares.ravel()[order[-2]], 0.0))
+
+
 def _direct_scaled_luma(source, result, source_luma):
     """The scaled luma as the scale tables computed it with NumPy's reductions over the last axis."""
     usable = (result < 1 - 1 / 512) & (source > 1e-4)
@@ -274,3 +315,25 @@ def test_every_phases_block_grain_from_the_running_spans_is_the_blocks_own(quali
         for column in range(compression.BLOCK):
             assert compression._grain_of_spans(spans[row::compression.BLOCK, column::compression.BLOCK]) \
                 == compression._block_grain_at(luma, row, column)
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.uint16, np.float32, np.float64])
+@pytest.mark.parametrize("channels", [None, 1, 3, 4])
+def test_the_window_choice_counts_the_edge_pixels_of_the_direct_formula(dtype, channels):
+    from aarecovery import sample
+    from aarecovery.colour import luma
+
+    rng = np.random.default_rng(3)
+    shape = (40, 50) if channels is None else (40, 50, channels)
+    # A walk whose steps straddle the edge step, so that rounding would show.
+    walk = np.clip(0.5 + np.cumsum(rng.normal(0, 0.06, size=shape), axis=1), 0, 1)
+    region = (np.rint(walk * np.iinfo(dtype).max) if np.dtype(dtype).kind == "u" else walk).astype(dtype)
+    values = region if region.ndim == 2 else region[..., 0] if region.shape[2] <= 2 else region[..., :3]
+    scale = np.float32(1 / np.iinfo(values.dtype).max) if values.dtype.kind in "ui" else np.float32(1)
+    light = values.astype(np.float32) * scale
+    if light.ndim == 3:
+        light = luma(light)
+    direct = (int((np.abs(np.diff(light, axis=1)) > sample._EDGE_STEP).sum())
+              + int((np.abs(np.diff(light, axis=0)) > sample._EDGE_STEP).sum()))
+    assert 0 < direct < 2 * light.size  # some steps above the edge step, some below
+    assert sample._edge_pixels(region) == direct

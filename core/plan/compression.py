@@ -250,15 +250,60 @@ def _column_transforms(luma, row):
     return _DCT @ luma[row:row + rows * BLOCK].reshape(rows, BLOCK, luma.shape[1])
 
 
-def _block_dct(luma, row, column, columns_done=None):
+def _block_dct(luma, row, column, columns_done=None, only=None):
     """Orthonormal 8 x 8 DCTs of the blocks of a grid at a phase, shape (N, 8, 8).
 
     `columns_done`: :func:`_column_transforms` of `luma` at `row`, where already computed.
+    `only`: bool, shape (block rows, block columns): the blocks to transform (N of them, in
+    row order), each to the same values as among all of them.
     """
     half = _column_transforms(luma, row) if columns_done is None else columns_done
     rows, columns = half.shape[0], (half.shape[2] - column) // BLOCK
     blocks = half[:, :, column:column + columns * BLOCK].reshape(rows, BLOCK, columns, BLOCK).transpose(0, 2, 1, 3)
+    if only is not None:
+        return blocks[only] @ _DCT.T
     return (blocks @ _DCT.T).reshape(-1, BLOCK, BLOCK)
+
+
+#: The share of a phase's blocks that may be busy (:func:`_may_be_busy`) below which the grid
+#: search transforms those only: a photo's 61% took 0.133 s against 0.119 s for all of them.
+_GATHERED_SHARE = 0.5
+
+
+def _summed_areas(luma):
+    """Summed-area tables of `luma` and of its square, shape (H + 1, W + 1), float64: every
+    block's sum and sum of squares in four reads (:func:`_may_be_busy`)."""
+    sums = np.zeros((luma.shape[0] + 1, luma.shape[1] + 1))
+    squares = np.zeros_like(sums)
+    np.cumsum(np.cumsum(luma, axis=0), axis=1, out=sums[1:, 1:])
+    np.cumsum(np.cumsum(luma * luma, axis=0), axis=1, out=squares[1:, 1:])
+    return sums, squares
+
+
+def _may_be_busy(sums, squares, row, column):
+    """bool, shape (block rows, block columns): the blocks of the grid at a phase that can hold
+    an AC coefficient above :data:`_BUSY_COEFFICIENT`; every other block is not busy.
+
+    The AC coefficients of an orthonormal DCT are the block's deviations from its mean in an
+    orthonormal basis, so together their squares are the deviations' (Parseval) and none
+    exceeds their root sum of squares: a block whose deviations' root sum of squares is at most
+    the busy level has no busy coefficient. On a drawing most blocks are flat or nearly so, and
+    the grid search transforms the rest only (a thresholded drawing's 512 x 512 window: 17-26%
+    of the blocks at a phase, the search 0.137 -> 0.074 s on a slow 2-core machine; a noisy
+    photo's 61%, all transformed: :data:`_GATHERED_SHARE`). The bound has a sixteenth of a level to
+    spare for the tables' rounding: a block near it is transformed, as before.
+    """
+    rows, columns = (sums.shape[0] - 1 - row) // BLOCK, (sums.shape[1] - 1 - column) // BLOCK
+    edges_y = np.arange(rows + 1) * BLOCK + row
+    edges_x = np.arange(columns + 1) * BLOCK + column
+
+    def block_totals(table):
+        corners = table[np.ix_(edges_y, edges_x)]
+        return corners[1:, 1:] - corners[:-1, 1:] - corners[1:, :-1] + corners[:-1, :-1]
+
+    total = block_totals(sums)
+    deviations = block_totals(squares) - total * total / (BLOCK * BLOCK)
+    return deviations > (_BUSY_COEFFICIENT - 1.0 / 16) ** 2
 
 
 def _busy(coefficients):
@@ -304,10 +349,14 @@ def detect_block_grid(encoded):
     if min(luma.shape) < 2 * BLOCK:
         return (0, 0), 0.0, None
     shares = np.full((BLOCK, BLOCK), -1.0)
+    sums, squares = _summed_areas(luma)
     for row in range(BLOCK):
         columns_done = _column_transforms(luma, row)
         for column in range(BLOCK):
-            coefficients = _block_dct(luma, row, column, columns_done)
+            candidates = _may_be_busy(sums, squares, row, column)
+            # Gathering most of the blocks costs more than transforming them all.
+            coefficients = _block_dct(luma, row, column, columns_done,
+                                      only=candidates if candidates.mean() < _GATHERED_SHARE else None)
             busy = _busy(coefficients)
             if busy.sum() >= _MIN_BUSY_BLOCKS:
                 shares[row, column] = float((np.abs(coefficients[busy][:, 3:, 3:]) < _ZERO_COEFFICIENT).mean())
