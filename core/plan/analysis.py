@@ -393,10 +393,11 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         # graphics 0.414 -> 0.446; per case -0.072 (the poster under G'MIC's pow 3) to +0.180;
         # the grey camera photo and text page (excluded) and no other case moved by over 0.01.
         # On a JPEG the drawn ink recurs within the compression noise (COMPRESSED_INK_SPAN).
-        # Measured and not taken: that span (and q 95's noise as the prior's guards, shift keys
-        # left as they are) for a colour O with no compression evidence too. Tuning half, 920
-        # cases: 63 up, 2 down (the PNG mixed scenes under Pillow's YCbCr equalization 0.617 ->
-        # 0.338 and 0.436 -> 0.346); colour photos under point-wise filters, PNG, 0.295 -> 0.310
+        # Measured and not taken: a colour O with no compression evidence read as a q 95 JPEG
+        # here (that span, q 95's noise as the prior's guards, no extrapolation, the luma
+        # purity). Tuning half, 920 cases: 63 up, 2 down (the PNG mixed scenes under Pillow's
+        # YCbCr equalization 0.617 -> 0.338 and 0.436 -> 0.346: a shift key's table extends
+        # nothing above noise); colour photos under point-wise filters, PNG, 0.295 -> 0.310
         # (each case +0.01 to +0.07), mixed text and graphics 0.556 -> 0.577, and the maps as q 98
         # JPEGs, whose grid the 96 px windows do not show, +0.07 to +0.28. But the gate opens on
         # half the edge pixels of a photo (rocket and chelsea 0.70-0.77, the bench's photo-like
