@@ -9,7 +9,6 @@ into the same environment (``.venv/bin/pip``, as the README's set-up makes it).
 import json
 import os
 import sys
-from importlib import metadata
 from urllib.parse import unquote, urlparse
 
 __all__ = ["install_command", "missing_extra", "extra_for"]
@@ -28,6 +27,9 @@ def _pip():
 
 def _source():
     """``(folder, editable)`` when aarecovery was installed from a local folder, else None."""
+    # Imported here, not with the module: importlib.metadata (with the email package) took
+    # 34 ms of every command's start, which needs it only to word a missing extra's fix.
+    from importlib import metadata
     try:
         text = metadata.distribution("aarecovery").read_text("direct_url.json")
     except metadata.PackageNotFoundError:
@@ -48,6 +50,7 @@ def _source():
 
 def _requirements(extra):
     """The extra's own requirements, as the installed metadata lists them."""
+    from importlib import metadata
     marker = f'extra == "{extra}"'
     found = []
     for requirement in metadata.distribution("aarecovery").requires or ():
@@ -63,6 +66,7 @@ def install_command(extra):
     source): ``aarecovery[extra]``. From a wheel or an archive, which pip cannot add an extra
     to by name: the extra's packages themselves.
     """
+    from importlib import metadata
     source = _source()
     if source is not None:
         folder, editable = source
