@@ -289,9 +289,10 @@ def _may_be_busy(sums, squares, row, column):
     exceeds their root sum of squares: a block whose deviations' root sum of squares is at most
     the busy level has no busy coefficient. On a drawing most blocks are flat or nearly so, and
     the grid search transforms the rest only (a thresholded drawing's 512 x 512 window: 17-26%
-    of the blocks at a phase, the search 0.137 -> 0.074 s on a slow 2-core machine; a noisy
-    photo's 61%, all transformed: :data:`_GATHERED_SHARE`). The bound has a sixteenth of a level to
-    spare for the tables' rounding: a block near it is transformed, as before.
+    of the blocks at a phase, the search 0.22 -> 0.07 s on a slow 2-core machine, separate
+    processes in turn; a noisy photo's 61%, all transformed: :data:`_GATHERED_SHARE`). The
+    bound has a sixteenth of a level to spare for the tables' rounding: a block near it is
+    transformed, as before.
     """
     rows, columns = (sums.shape[0] - 1 - row) // BLOCK, (sums.shape[1] - 1 - column) // BLOCK
     edges_y = np.arange(rows + 1) * BLOCK + row
