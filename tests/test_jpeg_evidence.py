@@ -43,6 +43,7 @@ def test_block_grid_is_found_in_a_decoded_jpeg_at_its_phase(quality):
     # The table the grid's steps give is the file's within a factor of two.
     bound = noise_from_tables(_tables(quality))
     assert bound / 2 <= found.noise <= bound * 2
+    assert found.noise == noise_from_tables([detect_block_grid(_encoded(jpeg))[2]])
 
 
 @pytest.mark.parametrize("textured", [False, True])
@@ -51,6 +52,8 @@ def test_lossless_pixels_show_no_compression(textured):
     evidence = compression_evidence(_encoded(png))
     assert evidence.source == NO_COMPRESSION.source and evidence.noise == 0 and not evidence.compressed
     assert detect_block_grid(_encoded(png))[1] < detect_block_grid(_encoded(scan_page(4, 95)[1]))[1]
+    # Undecided, the search measures no table (no caller reads one then).
+    assert detect_block_grid(_encoded(png))[2] is None
 
 
 def test_quantization_tables_are_read_from_jpeg_files_only(tmp_path):
