@@ -337,3 +337,31 @@ def test_the_window_choice_counts_the_edge_pixels_of_the_direct_formula(dtype, c
               + int((np.abs(np.diff(light, axis=0)) > sample._EDGE_STEP).sum()))
     assert 0 < direct < 2 * light.size  # some steps above the edge step, some below
     assert sample._edge_pixels(region) == direct
+
+
+def _direct_grain_spreads(encoded):
+    """The grain's spreads as stacked views gave them: the 3 x 3 span and that of the high pass."""
+    height, width = encoded.shape[:2]
+    padded = np.pad(encoded, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    window = [padded[dy:dy + height, dx:dx + width] for dy in range(3) for dx in range(3)]
+    high = encoded - np.mean(window, axis=0)
+    padded = np.pad(high, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    high_window = [padded[dy:dy + height, dx:dx + width] for dy in range(3) for dx in range(3)]
+    return (np.max(window, axis=0) - np.min(window, axis=0),
+            np.max(high_window, axis=0) - np.min(high_window, axis=0))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_grain_by_running_sums_and_extremes_is_that_of_the_stacked_views(seed):
+    from aarecovery.plan import texture
+    from aarecovery.spec.sobel import gradient_magnitude
+
+    rng = np.random.default_rng(seed)
+    image = _drawn_and_noisy(seed, height=64, width=64) * np.float32(0.2)
+    image[32:] += rng.normal(0, 2 / 255, (32, 64, 3)).astype(np.float32)  # grain on half the page
+    image = np.clip(image, 0, 1)
+    spread, high_spread = _direct_grain_spreads(image)
+    quiet = ~texture._spread(gradient_magnitude(image) > texture._QUIET_GRADIENT, texture._QUIET_DISTANCE)
+    grainy = (largest_channel(spread) > texture._GRAIN_RANGE) & (largest_channel(high_spread) > texture._GRAIN_HIGH_PASS)
+    assert quiet.sum() >= texture._MIN_QUIET and 0 < grainy[quiet].mean() < 1
+    assert texture.grain(image) == float(grainy[quiet].mean())

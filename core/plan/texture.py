@@ -29,6 +29,7 @@ that hold an edge, so that a JPEG drawing is flat there and a photo is not.
 import numpy as np
 
 from ..colour import largest_channel
+from ..spec.local_plan import neighbourhood_extremes
 from ..spec.sobel import gradient_magnitude
 from .compression import BLOCK_GRAIN_SHARE, quiet_block_grain
 
@@ -64,10 +65,19 @@ def _spread(mask, radius):
     return out
 
 
-def _neighbours(image):
+def _neighbourhood_mean(image):
+    """The mean of each pixel's 3 x 3 neighbourhood (borders replicated), its nine values
+    added in the order NumPy's mean of the nine stacked views adds them: the same values
+    without the (9, H, W, 3) copy (the grain 0.07 -> 0.055 s on a 512 x 512 window, with
+    the running extremes)."""
     height, width = image.shape[:2]
     padded = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
-    return [padded[1 + dy:1 + dy + height, 1 + dx:1 + dx + width] for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
+    total = padded[:height, :width].copy()
+    for dy in range(3):
+        for dx in range(3):
+            if dy or dx:
+                np.add(total, padded[dy:dy + height, dx:dx + width], out=total)
+    return total / 9
 
 
 def grain(encoded):
@@ -87,10 +97,10 @@ def grain(encoded):
     quiet = ~_spread(gradient_magnitude(encoded) > _QUIET_GRADIENT, _QUIET_DISTANCE)
     if quiet.sum() < _MIN_QUIET:
         return None
-    window = _neighbours(encoded)
-    spread = largest_channel(np.max(window, axis=0) - np.min(window, axis=0))
-    high_pass = _neighbours(encoded - np.mean(window, axis=0))
-    high_pass_spread = largest_channel(np.max(high_pass, axis=0) - np.min(high_pass, axis=0))
+    brightest, darkest = neighbourhood_extremes(encoded)
+    spread = largest_channel(brightest - darkest)
+    brightest, darkest = neighbourhood_extremes(encoded - _neighbourhood_mean(encoded))
+    high_pass_spread = largest_channel(brightest - darkest)
     grainy = (spread > _GRAIN_RANGE) & (high_pass_spread > _GRAIN_HIGH_PASS)
     return float(grainy[quiet].mean())
 
