@@ -362,6 +362,7 @@ def test_the_grain_by_running_sums_and_extremes_is_that_of_the_stacked_views(see
     image = np.clip(image, 0, 1)
     spread, high_spread = _direct_grain_spreads(image)
     quiet = ~texture._spread(gradient_magnitude(image) > texture._QUIET_GRADIENT, texture._QUIET_DISTANCE)
-    grainy = (largest_channel(spread) > texture._GRAIN_RANGE) & (largest_channel(high_spread) > texture._GRAIN_HIGH_PASS)
+    grainy = ((largest_channel(spread) > texture._GRAIN_RANGE)
+              & (largest_channel(high_spread) > texture._GRAIN_HIGH_PASS))
     assert quiet.sum() >= texture._MIN_QUIET and 0 < grainy[quiet].mean() < 1
     assert texture.grain(image) == float(grainy[quiet].mean())
