@@ -23,6 +23,8 @@ TWINS = {
     ("pure_colours.glsl", "END_TOLERANCE"): pure_colours.END_TOLERANCE,
     ("pure_colours.glsl", "MIN_CONTRAST"): pure_colours.MIN_CONTRAST,
     ("pure_colours.glsl", "MIN_REACH"): pure_colours.MIN_REACH,
+    ("pure_colours.glsl", "INK_TOLERANCE"): pure_colours.INK_TOLERANCE,
+    ("pure_colours.glsl", "SHORT_REACH"): pure_colours.SHORT_REACH,
     ("pure_colours.glsl", "OPENCV_Y"): pure_colours._OPENCV_Y,
     ("pure_colours.glsl", "PILLOW_Y"): pure_colours._PILLOW_Y,
     ("local_plan.glsl", "FLAT_SPAN"): local_plan.FLAT_SPAN,
@@ -76,6 +78,10 @@ def test_luma_weights_are_the_same_in_glsl():
 
 def test_palette_array_holds_the_palette_size():
     assert f"uniform vec3 palette[{pure_colours.PALETTE_SIZE}];" in read_source("pure_colours.glsl")
+
+
+def test_ink_array_holds_the_ink_count():
+    assert f"uniform vec3 inks[{pure_colours.INK_COUNT}];" in read_source("pure_colours.glsl")
 
 
 def test_em_iterations_match():

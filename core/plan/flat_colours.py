@@ -29,7 +29,7 @@ import numpy as np
 
 from ..colour import largest_channel
 from ..spec.pure_colours import PureColourPrior
-from .pure_colours import palette_of
+from .pure_colours import inks_of, palette_of
 
 __all__ = ["flat_kept_share", "colour_line_miss", "flat_colour_prior", "FLAT_KEPT_SHARE", "LINE_MISS"]
 
@@ -158,4 +158,5 @@ def flat_colour_prior(original, filtered, edges):
         return None, reason
     centres = (np.arange(256, dtype=np.float32) + np.float32(0.5)) / np.float32(256)
     identity = np.repeat(centres[:, None], 3, axis=1)
-    return PureColourPrior("channel", identity, palette_of(original), to_cube=True, explain_filtered=False), reason
+    return PureColourPrior("channel", identity, palette_of(original), to_cube=True, explain_filtered=False,
+                           inks=inks_of(original)), reason

@@ -13,11 +13,11 @@ import numpy as np
 from ..colour import largest_channel
 from ..params import SIGMA_D, SIGMA_E
 from ..spec import to_working_space
-from ..spec.pure_colours import (EXTENSION_KEYS, PALETTE_SIZE, SCALE_KEYS, SHIFT_KEYS, PureColourPrior, filtered_colour,
-                                 fit_pure_colour_model)
+from ..spec.pure_colours import (EXTENSION_KEYS, INK_COUNT, INK_TOLERANCE, PALETTE_SIZE, SCALE_KEYS, SHIFT_KEYS,
+                                 PureColourPrior, filtered_colour, fit_pure_colour_model)
 from .pointwise import POINTWISE_SHARE, TABLE_KEYS, filled_bins, key_of
 
-__all__ = ["palette_of", "is_monotone", "turns_at_most_once", "ONE_TURN_VARIATION", "extrapolate_table",
+__all__ = ["palette_of", "inks_of", "is_monotone", "turns_at_most_once", "ONE_TURN_VARIATION", "extrapolate_table",
            "pure_colour_prior", "affine_in_key_miss", "STRAIGHT_TABLE_MISS", "COMPRESSED_LUMA_PURITY"]
 
 # A flat pixel's 3x3 neighbourhood lies within this of its colour (encoded values), and a
@@ -102,13 +102,34 @@ def palette_of(original):
         them, seen at least 4 times.
     """
     levels = np.rint(np.clip(original[_flat(original)], 0, 1) * 255).astype(np.int64)
+    return _most_frequent(levels, PALETTE_SIZE)
+
+
+def _most_frequent(levels, limit):
+    """The 8-bit colours ``(N, 3)`` of `levels` seen at least :data:`_PALETTE_MIN_COUNT` times,
+    the `limit` most frequent first, as float32 in [0, 1]."""
     if not len(levels):
         return np.zeros((0, 3), np.float32)
     codes = (levels[:, 0] * 256 + levels[:, 1]) * 256 + levels[:, 2]
     unique, counts = np.unique(codes, return_counts=True)
-    order = np.argsort(-counts, kind="stable")[:PALETTE_SIZE]
+    order = np.argsort(-counts, kind="stable")[:limit]
     kept = unique[order][counts[order] >= _PALETTE_MIN_COUNT]
     return (np.stack([kept // 65536, kept // 256 % 256, kept % 256], -1) / np.float32(255)).astype(np.float32)
+
+
+def inks_of(original):
+    """The colours on the colour cube's faces that an image shows at several pixels, most
+    frequent first (``PureColourPrior.inks``).
+
+    Black, white and saturated inks are seen whole in strokes too thin to leave a flat pixel;
+    their partial colours' extensions to the cube land on them. `original` as for
+    :func:`palette_of`; the result too, with N <= ``INK_COUNT`` colours seen at least 4 times
+    (flat or not) that have a channel within ``INK_TOLERANCE`` of 0 or 1.
+    """
+    levels = np.rint(np.clip(original.reshape(-1, 3), 0, 1) * 255).astype(np.int32)
+    reach = int(round(INK_TOLERANCE * 255))
+    on_face = ((levels <= reach) | (levels >= 255 - reach)).any(axis=1)
+    return _most_frequent(levels[on_face], INK_COUNT)
 
 
 def _flat(original):
@@ -257,7 +278,7 @@ def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None
     PureColourPrior or None
         None when no candidate qualifies.
     """
-    palette = palette_of(original)
+    palette, inks = palette_of(original), inks_of(original)
     eligible = [candidate for candidate in transfer.alternatives
                 if candidate.consistency >= POINTWISE_SHARE and candidate.key in EXTENSION_KEYS]
     # A monotone table first; failing one, a colour map's hump (turns_at_most_once), only of a
@@ -280,7 +301,7 @@ def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None
     fit = others or ([] if noise_contrast > 0 else fit)
     if not fit:
         return None
-    priors = [PureColourPrior(candidate.key, palette=palette, noise_contrast=float(noise_contrast),
+    priors = [PureColourPrior(candidate.key, palette=palette, inks=inks, noise_contrast=float(noise_contrast),
                               ridge_noise=float(ridge_noise), luma_purity=float(luma_purity),
                               **_extrapolated(original, candidate, extend_ends))
               for candidate in fit

@@ -60,6 +60,12 @@ but a line two pixels wide at full coverage looks the same. Tuning half, drawing
 mixed scenes at 96 px, PNG and JPEG (736 cases): 153 up, 65 down, the star burst's PNG mean
 0.692 -> 0.716 and the maps' 0.514 -> 0.520, but the screenshot's interface chrome 0.385 ->
 0.362 and its text and graphics regions with the other mixed scene's 0.349 -> 0.340.
+Nor is a ridge exempt where it runs along a row or column in one exact colour (8 pixels
+or more: a rule one pixel wide on the pixel grid, drawn in its own grey, looks like a
+half-pixel hairline of black there, and the held-out pie charts lose 0.38 dB by it). On
+the same 736 tuning cases such runs were mostly thin features' partial colours: 9 up, 152
+down (the screenshot's interface rules 0.385 -> 0.370, the manga's panel borders 0.568 ->
+0.551, the maps 0.514 -> 0.502).
 
 This module is the NumPy specification; ``pure_colours.glsl``, included by the GL fit pass
 (``#if PURE_COLOURS``), is its GL twin. ``aarecovery.plan.pure_colours`` builds the prior.
@@ -75,7 +81,7 @@ from .local_plan import FLAT_SPAN
 from .neighbourhood import NEIGHBOUR_OFFSETS, dot, neighbours, planes
 from .sobel import sobel_magnitude
 
-__all__ = ["PureColourPrior", "is_flat_colour", "PALETTE_SIZE", "ON_LINE_TOLERANCE", "KEPT_CONTRAST", "EXTENSION_KEYS",
+__all__ = ["PureColourPrior", "is_flat_colour", "PALETTE_SIZE", "INK_COUNT", "ON_LINE_TOLERANCE", "KEPT_CONTRAST", "EXTENSION_KEYS",
            "SCALE_KEYS", "SHIFT_KEYS", "filtered_colour", "extend_extreme", "scale_transfer", "key_values", "shift_grey",
            "rec601_grey", "fit_pure_colour_model"]
 
@@ -113,6 +119,25 @@ RIDGE_NOISE_MARGIN = 1.5
 #: differently on an NVIDIA H100 and in NumPy (R 0.045 apart after one iteration). Built-in
 #: suite: two text cases +0.001, the means unchanged; real-tools quick tuning half unchanged.
 MIN_REACH = 1.2001
+#: ... unless the pure colour is one O shows: a flat colour of O stops the extension (see
+#: :func:`extend_extreme`), or the point on the cube lies within this (encoded, each channel)
+#: of one of O's recurring inks (``PureColourPrior.inks``). Then the extreme is a partial
+#: colour after all, however close to its ink: a pixel 86 % covered by green ink (0, 89, 38)
+#: on grey-green paper, under G'MIC's ``-pow 3`` (whose curve ends in a step at 6 levels),
+#: shows 36 in the reference and 255 in F, and without its pure colour it stayed 255. Tuning
+#: half, drawings, scans and mixed scenes at 96 px (736 cases, PNG and JPEG): 134 up, 6 down
+#: by at most 0.032 (the star burst under ImageMagick's unsharp mask 0.69-0.72 -> 0.66-0.69,
+#: the memo under GEGL's posterize at q 80 0.355 -> 0.325); manga PNG 0.568 -> 0.608, JPEG
+#: 0.518 -> 0.557, serif PNG 0.870 -> 0.883 (under ``-pow 3`` 0.08 -> 0.16-0.24), the
+#: screenshot 0.385 -> 0.406. The flat colours alone gave 0.579 on the manga, the inks alone
+#: 75 up and 2 down; any recurring colour as an ink (no face, no cap) 126 up, 7 down; two
+#: recurrences instead of four 8 down; no rule at all (MIN_REACH 1) 261 up and 53 down, the
+#: star burst under GEGL's levels 0.52 -> 0.11, as above.
+INK_TOLERANCE = 2.0 / 255
+#: Most inks kept (a uniform array in the GL pass), the most frequent first.
+INK_COUNT = 16
+#: An extreme on the colour cube's face already (reach 1) is its own pure colour.
+SHORT_REACH = 1.0001
 # The table must reproduce F at the observed extreme within this (working space).
 EXPLAIN_TOLERANCE = 0.02
 #: Without a fitted table (a neighbourhood filter that keeps flat colours), F at the extreme
@@ -229,6 +254,12 @@ class PureColourPrior:
         With `ink_gate`: how close a colour must be to the ink to recur (encoded; the `span`
         of ``aarecovery.spec.local_plan.ink_weight``): the 8-bit level, or on a JPEG, whose
         ink recurs only within its noise, a wider span (``aarecovery.plan.mixed_content``).
+    inks : ndarray of float32, shape (N, 3), N <= INK_COUNT, optional
+        sRGB-encoded colours that O shows at four pixels or more and that lie on the colour
+        cube's faces (within :data:`INK_TOLERANCE`): black, white, saturated inks, seen
+        whole somewhere though not flat (``aarecovery.plan.pure_colours.inks_of``). A partial
+        colour whose extension to the cube lands on one is extended even when the reach is
+        short (:data:`MIN_REACH`). None: no inks.
     luma_purity : float
         An extreme whose luma lies within this of a flat colour's (working space, Rec. 709
         weights on the premultiplied colours) is that flat colour too (:func:`is_flat_colour`):
@@ -251,6 +282,7 @@ class PureColourPrior:
     ink_gate: bool = False
     ink_span: float = FLAT_SPAN
     luma_purity: float = 0.0
+    inks: np.ndarray = None
 
     @property
     def min_contrast(self):
@@ -525,6 +557,7 @@ def extend_extreme(far, near, around, filtered_far, on_border, palette, prior, b
     # legend). Measured on the real-tools tuning half, drawings with PNG originals: mean
     # error reduction 0.488 -> 0.544 (levels 0.33 -> 0.64: dark-blue spokes were extended
     # to a black they never were); built-in quick suite +0.001 in both spaces.
+    cube_reach = reach
     nearest = np.full(length.shape, np.float32(1e6))
     for colour in palette:
         ink = np.concatenate([colour, [np.float32(1)]])[:, None].astype(np.float32)
@@ -537,7 +570,14 @@ def extend_extreme(far, near, around, filtered_far, on_border, palette, prior, b
     reach = np.where(found, np.minimum(nearest, reach), reach).astype(np.float32)
     if not prior.to_cube:
         candidate &= found
-    candidate &= reach > np.float32(MIN_REACH)
+    # A short reach is the ink itself, unless O shows the pure colour: a flat colour stopped
+    # the extension, or the cube's point is one of O's inks.
+    seen = found & (nearest <= cube_reach)
+    if prior.inks is not None and len(prior.inks):
+        pure = _encoded_of(near + reach * span, blend_space)
+        for ink in np.asarray(prior.inks, np.float32):
+            seen |= np.abs(pure - ink[:, None]).max(axis=0) <= np.float32(INK_TOLERANCE)
+    candidate &= (reach > np.float32(MIN_REACH)) | (seen & (reach > np.float32(SHORT_REACH)))
     if gate is not None:
         candidate &= gate > 0
         reach = (np.float32(1) + gate * (reach - np.float32(1))).astype(np.float32)

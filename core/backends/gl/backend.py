@@ -46,7 +46,7 @@ import moderngl
 import numpy as np
 
 from ...spec.local_plan import FLAT_SPAN, LocalStrength, strength_map
-from ...spec.pure_colours import PALETTE_SIZE
+from ...spec.pure_colours import INK_COUNT, PALETTE_SIZE
 from ...tiling import DEFAULT_TILES
 from ..base import Capabilities, ReadyResult, RecoveryMaps
 from .classify import BlockClassifier, BlockLists, block_grid
@@ -520,8 +520,12 @@ class GLBackend:
         palette = np.zeros((PALETTE_SIZE, 3), np.float32)
         colours = prior.palette_in(self._blend_space)
         palette[:len(colours)] = colours
+        inks = np.zeros((INK_COUNT, 3), np.float32)
+        seen = np.zeros((0, 3), np.float32) if prior.inks is None else np.asarray(prior.inks, np.float32)
+        inks[:len(seen)] = seen
         low, high = prior.key_range()
         return dict(palette_size=len(colours), palette=[tuple(map(float, colour)) for colour in palette],
+                    ink_count=len(seen), inks=[tuple(map(float, colour)) for colour in inks],
                     key_low=tuple(map(float, low)), key_high=tuple(map(float, high)),
                     noise_contrast=float(prior.noise_contrast), ridge_noise=float(prior.ridge_noise),
                     luma_purity=float(prior.luma_purity))

@@ -5,6 +5,8 @@
 uniform sampler2D transfer_table;  // 256 x 1: the filter's table, encoded output per key bin
 uniform vec3 palette[32];          // O's flat colours, opaque, in the working space
 uniform int palette_size;
+uniform vec3 inks[16];             // O's recurring colours on the cube's faces, encoded
+uniform int ink_count;
 uniform vec3 key_low;              // O's key range (bin centres of the table's first and last
 uniform vec3 key_high;             // filled bins, per column); beyond it the table is extrapolated
 uniform float noise_contrast;      // O's compression noise as a contrast (0: not compressed)
@@ -58,6 +60,8 @@ const float RANGE_TOLERANCE = 0.05;
 const float END_TOLERANCE = 1.0 / 255.0;
 const float MIN_CONTRAST = 8.5 / 255.0;
 const float MIN_REACH = 1.2001;
+const float INK_TOLERANCE = 2.0 / 255.0;
+const float SHORT_REACH = 1.0001;
 // The tools' fixed-point Rec. 601 Y (spec.pure_colours._OPENCV_Y, _PILLOW_Y, _REC601_Y):
 // weights and scale.
 const vec4 OPENCV_Y = vec4(4899.0, 9617.0, 1868.0, 16384.0);
@@ -267,6 +271,7 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
         reach = min(reach, min(up, down));
     }
     reach = max(reach, 1.0);
+    float cube_reach = reach;
     // A flat colour of O beyond the extreme, on its line, is the feature's ink.
     float nearest = 1e6;
     for (int i = 0; i < palette_size; ++i) {
@@ -280,7 +285,17 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
 #if !TO_CUBE
     else return result;
 #endif
-    if (!(reach > MIN_REACH)) return result;  // the extreme is the ink itself
+    if (!(reach > MIN_REACH)) {
+        // The extreme is the ink itself, unless O shows the pure colour: a flat colour
+        // stopped the extension, or the cube's point is one of O's inks.
+        bool seen = nearest < 1e5 && nearest <= cube_reach;
+        vec3 pure_encoded = encoded_of(near + reach * span);
+        for (int i = 0; i < ink_count; ++i) {
+            vec3 miss = abs(pure_encoded - inks[i]);
+            seen = seen || max(max(miss.r, miss.g), miss.b) <= INK_TOLERANCE;
+        }
+        if (!seen || !(reach > SHORT_REACH)) return result;
+    }
 #if PURE_GATE
     reach = 1.0 + gate * (reach - 1.0);
 #endif
