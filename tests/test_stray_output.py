@@ -2,11 +2,13 @@
 no warnings of the libraries below it (libpng, Mesa's EGL) beside them."""
 
 import os
+import shutil
 import subprocess
 import sys
 from importlib import resources
 
 import numpy as np
+import pytest
 
 from aarecovery import write_image
 
@@ -30,15 +32,48 @@ def test_the_bundled_images_decode_without_library_warnings():
     assert done.returncode == 0 and done.stderr == "", done.stderr
 
 
+def _recover_with_a_broken_driver(folder, **variables):
+    """stderr lines of ``recover`` where Mesa has no Gallium driver it can load, with our
+    settings of the libraries' logging left to the command."""
+    ramp = np.tile(np.linspace(0, 255, 32).astype(np.uint8), (24, 1))
+    write_image(folder / "o.png", ramp)
+    write_image(folder / "f.png", np.where(ramp > 127, 255, 0).astype(np.uint8))
+    environment = {name: value for name, value in os.environ.items() if name not in ("EGL_LOG_LEVEL", "LIBGL_DEBUG")}
+    environment.update(GALLIUM_DRIVER="no-such-driver", **variables)
+    status, lines = _stderr_lines("recover", folder / "o.png", folder / "f.png", "-o", folder / "r.png",
+                                  env=environment)
+    assert status == 0 and lines, lines
+    return lines
+
+
 def test_a_gl_driver_that_fails_to_load_says_so_in_our_line_only(tmp_path):
     # Mesa without a usable Gallium driver: its EGL printed "libEGL warning: egl: failed to
     # create dri2 screen" twice before our fallback warning.
-    ramp = np.tile(np.linspace(0, 255, 32).astype(np.uint8), (24, 1))
-    write_image(tmp_path / "o.png", ramp)
-    write_image(tmp_path / "f.png", np.where(ramp > 127, 255, 0).astype(np.uint8))
-    environment = {name: value for name, value in os.environ.items() if name != "EGL_LOG_LEVEL"}
-    environment["GALLIUM_DRIVER"] = "no-such-driver"
-    status, lines = _stderr_lines("recover", tmp_path / "o.png", tmp_path / "f.png", "-o", tmp_path / "r.png",
-                                  env=environment)
-    assert status == 0 and lines, lines
+    lines = _recover_with_a_broken_driver(tmp_path)
+    assert all(line.startswith("aarecovery: ") for line in lines), lines
+
+
+def test_a_gl_driver_that_fails_to_load_beside_an_x_server_says_so_in_our_line_only(tmp_path):
+    # Where EGL fails, the platform's default (GLX) is tried next, and where an X server
+    # answers (a desktop, or any Xvfb on display :0 even without DISPLAY set) libGL printed
+    # "libGL error: failed to load driver: swrast" and three more lines before ours.
+    executable = shutil.which("Xvfb")
+    if executable is None:
+        message = "Xvfb is not installed (apt-get install xvfb; packaging/test.sh does as root)"
+        if os.environ.get("CI"):
+            pytest.fail(message, pytrace=False)
+        pytest.skip(message)
+    read_end, write_end = os.pipe()
+    server = subprocess.Popen([executable, "-displayfd", str(write_end), "-screen", "0", "320x240x24", "-nolisten",
+                               "tcp", "-noreset"], pass_fds=(write_end,), stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)
+    os.close(write_end)
+    try:
+        with os.fdopen(read_end) as pipe:
+            number = pipe.readline().strip()
+        assert number, "Xvfb reported no display number"
+        lines = _recover_with_a_broken_driver(tmp_path, DISPLAY=f":{number}")
+    finally:
+        server.terminate()
+        server.wait(timeout=10)
     assert all(line.startswith("aarecovery: ") for line in lines), lines

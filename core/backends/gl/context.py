@@ -1,6 +1,8 @@
 """Making a standalone OpenGL 3.3 context, or saying clearly why there is none."""
 
 import os
+import sys
+from contextlib import contextmanager, nullcontext
 
 import moderngl
 
@@ -53,10 +55,34 @@ def create_context():
         # for (a request for 3.3 gave an H100 a 3.3 context and so only the fragment path,
         # 0.11-0.15 GP/s), where Mesa makes its newest either way.
         for version in (COMPUTE_VERSION, REQUIRED_VERSION):
-            try:
-                return moderngl.create_standalone_context(require=version, **options)
-            except Exception as error:  # the context libraries raise bare Exception subclasses
-                text = str(error).strip()
-                reasons.append(f"{label} {version // 100}.{version // 10 % 10}: "
-                               f"{text.splitlines()[0] if text else type(error).__name__}")
+            # Where EGL failed, the platform's default follows: on Linux GLX, whose libGL
+            # prints "libGL error: failed to load driver" as a fatal message, which no
+            # variable quiets, wherever an X server answers (any on display :0, DISPLAY set
+            # or not). Its reasons come back in the exception too.
+            with _stderr_discarded() if label == "default" else nullcontext():
+                try:
+                    return moderngl.create_standalone_context(require=version, **options)
+                except Exception as error:  # the context libraries raise bare Exception subclasses
+                    text = str(error).strip()
+                    reasons.append(f"{label} {version // 100}.{version // 10 % 10}: "
+                                   f"{text.splitlines()[0] if text else type(error).__name__}")
     raise GLUnavailable("; ".join(reasons))
+
+
+@contextmanager
+def _stderr_discarded():
+    """Send what C libraries write to file descriptor 2 to the null device inside the block."""
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError, AttributeError):  # no descriptor 2 (a GUI host without one)
+        yield
+        return
+    null = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(null)
