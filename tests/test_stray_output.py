@@ -2,13 +2,12 @@
 no warnings of the libraries below it (libpng, Mesa's EGL) beside them."""
 
 import os
-import shutil
 import subprocess
 import sys
 from importlib import resources
 
 import numpy as np
-import pytest
+from xvfb import xvfb_server
 
 from aarecovery import write_image
 
@@ -57,23 +56,6 @@ def test_a_gl_driver_that_fails_to_load_beside_an_x_server_says_so_in_our_line_o
     # Where EGL fails, the platform's default (GLX) is tried next, and where an X server
     # answers (a desktop, or any Xvfb on display :0 even without DISPLAY set) libGL printed
     # "libGL error: failed to load driver: swrast" and three more lines before ours.
-    executable = shutil.which("Xvfb")
-    if executable is None:
-        message = "Xvfb is not installed (apt-get install xvfb; packaging/test.sh does as root)"
-        if os.environ.get("CI"):
-            pytest.fail(message, pytrace=False)
-        pytest.skip(message)
-    read_end, write_end = os.pipe()
-    server = subprocess.Popen([executable, "-displayfd", str(write_end), "-screen", "0", "320x240x24", "-nolisten",
-                               "tcp", "-noreset"], pass_fds=(write_end,), stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL)
-    os.close(write_end)
-    try:
-        with os.fdopen(read_end) as pipe:
-            number = pipe.readline().strip()
-        assert number, "Xvfb reported no display number"
-        lines = _recover_with_a_broken_driver(tmp_path, DISPLAY=f":{number}")
-    finally:
-        server.terminate()
-        server.wait(timeout=10)
+    with xvfb_server("320x240x24") as display:
+        lines = _recover_with_a_broken_driver(tmp_path, DISPLAY=display)
     assert all(line.startswith("aarecovery: ") for line in lines), lines
