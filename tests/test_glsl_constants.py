@@ -8,7 +8,7 @@ import pytest
 from aarecovery import colour
 from aarecovery.backends.gl import blocks
 from aarecovery.backends.gl.glsl import read_source
-from aarecovery.spec import blend_model, local_plan, pure_colours, working_space
+from aarecovery.spec import blend_model, local_plan, pure_colours, ramp_lookup, working_space
 
 # (shader file, GLSL name) -> the value the NumPy specification uses.
 TWINS = {
@@ -25,8 +25,11 @@ TWINS = {
     ("pure_colours.glsl", "MIN_REACH"): pure_colours.MIN_REACH,
     ("pure_colours.glsl", "INK_TOLERANCE"): pure_colours.INK_TOLERANCE,
     ("pure_colours.glsl", "SHORT_REACH"): pure_colours.SHORT_REACH,
-    ("pure_colours.glsl", "OPENCV_Y"): pure_colours._OPENCV_Y,
-    ("pure_colours.glsl", "PILLOW_Y"): pure_colours._PILLOW_Y,
+    ("transfer_table.glsl", "OPENCV_Y"): pure_colours._OPENCV_Y,
+    ("transfer_table.glsl", "PILLOW_Y"): pure_colours._PILLOW_Y,
+    ("transfer_table.glsl", "REC601_Y"): pure_colours._REC601_Y,
+    ("ramp_lookup.glsl", "RAMP_SAMPLES"): ramp_lookup.RAMP_SAMPLES,
+    ("ramp_lookup.glsl", "RAMP_BEND"): ramp_lookup.RAMP_BEND,
     ("local_plan.glsl", "FLAT_SPAN"): local_plan.FLAT_SPAN,
     ("local_plan.glsl", "REGION_RADIUS"): local_plan.REGION_RADIUS,
     ("local_plan.glsl", "TEXTURED_SHARE"): local_plan.TEXTURED_SHARE,

@@ -29,6 +29,10 @@ def test_the_local_plan_repairs_the_graphics_more_and_the_photo_as_much():
         engine.set_images(case.original, case.filtered)
         plan = engine.plan()
         assert plan.local is not None, plan.reason
+        # Without the ramp lookup in both, which acts as far as the model does not and so
+        # repairs more of the graphics under one low strength: the local plan's own share
+        # (measured: with the lookup 0.635 against 0.613, without it 0.609 against 0.532).
+        plan = dataclasses.replace(plan, ramp_table=None)
         engine.run(plan)
         local = measure_regions(case, engine.result())
         # One strength everywhere, as before the local plan (no pure colours on a photo).

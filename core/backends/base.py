@@ -108,6 +108,10 @@ class Plan:
     forcing : Forcing or None
         Where the safe default keeps F: whether forcing a repair may help, and why or what
         it risks (``aarecovery.plan.forcing``).
+    ramp_table : RampTable or None
+        The ramp lookup's table (``aarecovery.spec.ramp_lookup``): R takes the table averaged
+        across each pixel where O is a ramp, as far as the model's confidence leaves it;
+        None: no ramp lookup. Only for sRGB-encoded inputs (its delta is in encoded values).
     window : tuple of slice or None
         The rows and columns of the pair that the safe default's analysis read
         (``aarecovery.sample``), when the plan was made from the whole pair: the summary
@@ -128,6 +132,7 @@ class Plan:
     toward_original: bool = False
     forcing: object = None
     window: tuple = None
+    ramp_table: object = None
 
     @property
     def keeps_filtered(self):

@@ -5,6 +5,7 @@ import numpy as np
 from ..contract import to_rgba_float
 from ..spec import BlendModel, from_working_space, recover_working, to_working_space
 from ..spec.local_plan import LocalStrength, encoded_colour, strength_map
+from ..spec.ramp_lookup import ramp_lookup
 from ..tiling import DEFAULT_TILES, halo_for
 from .base import Capabilities, ReadyResult, RecoveryMaps
 
@@ -45,12 +46,13 @@ class NumpyBackend:
     def __init__(self):
         self._original = self._filtered = self._filtered_rgba = None
         self._result = self._model = self._strength = None
-        self._encoded = None
+        self._encoded = self._original_rgba = None
 
     def load(self, original, o_layout, filtered, f_layout, linear_input, blend_space):
         self._space = dict(linear_input=linear_input, blend_space=blend_space)
         self._filtered_rgba = to_rgba_float(filtered, f_layout, "filtered")
         original_rgba = to_rgba_float(original, o_layout, "original")
+        self._original_rgba = original_rgba
         self._encoded = encoded_colour(original_rgba, linear_input)
         self._original = to_working_space(original_rgba, **self._space)
         self._filtered = to_working_space(self._filtered_rgba, **self._space)
@@ -73,6 +75,9 @@ class NumpyBackend:
         recovered, model = _recover_in_strips(self._original, self._filtered, plan, factor, gate, toward)
         self._result = from_working_space(recovered, self._filtered_rgba, filtered_work=self._filtered,
                                           **self._space)
+        if plan.ramp_table is not None and plan.iterations > 0:
+            self._result = ramp_lookup(self._result, self._original_rgba, self._filtered_rgba, model.beta,
+                                       plan.ramp_table)
         self._model = model
         self._strength = strength_map(plan, factor, self._original.shape[:2]) if maps else None
 

@@ -71,4 +71,6 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
                 mode="safe", decision=analysis.decision, local=analysis.local if asked is None else None,
                 untouched_span=analysis.untouched_span if asked is None else 0.0,
                 toward_original=analysis.toward_original and asked is None, forcing=analysis.forcing,
+                # The ramp lookup's delta is in sRGB-encoded values, the table's.
+                ramp_table=None if linear else analysis.ramp_table,
                 reason=analysis.reason + ("" if asked is None else f"; strength {asked:g} as asked instead"))

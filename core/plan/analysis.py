@@ -91,6 +91,7 @@ from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
 from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, SHARPENED_GRAIN_BLEND_SPACE, grain_edge_scale, paper_grain
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import COMPRESSED_LUMA_PURITY, pure_colour_prior
+from .ramp import ramp_table_of
 from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, UNTOUCHED_SPAN, contrast_ratio, keeps_flat_colours
 from .texture import is_grey, is_textured
 
@@ -191,6 +192,9 @@ class PairAnalysis:
     toward_original : bool
         Under a smoothing filter that keeps O's colours: the drawn content's edge pixels move
         towards O's (``aarecovery.plan.smoothing``, ``Plan.toward_original``).
+    ramp_table : RampTable or None
+        Where a point-wise table is repaired at a calibrated strength: the table the ramp
+        lookup averages across O's ramps (``aarecovery.plan.ramp``); None: no ramp lookup.
     """
 
     blend_space: str
@@ -203,6 +207,7 @@ class PairAnalysis:
     edge_scale: float = 1.0
     untouched_span: float = 0.0
     toward_original: bool = False
+    ramp_table: object = None
 
 
 def analysis_crop(image):
@@ -357,7 +362,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                 f"on hard-edged content{thin} above {above}; half-resolution "
                                 f"calibration chose strength {strength:g}", decision, prior,
                                 forcing=forcing_advice(decision, errors=errors) if strength == 0 else None,
-                                edge_scale=grain_edge_scale(grain, o, f, edges, space, sigma_e))
+                                edge_scale=grain_edge_scale(grain, o, f, edges, space, sigma_e),
+                                ramp_table=ramp_table_of(transfer, prior) if strength > 0 else None)
         return PairAnalysis(space, 1.0, f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges "
                                         f"match) on hard-edged content: full strength{thin}",
                             Decision.POINTWISE_HARD_EDGED, prior)
@@ -368,7 +374,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         if not 0 < strength < 1:
             return PairAnalysis(space, strength, why, Decision.POINTWISE_CALIBRATED,
                                 forcing=forcing_advice(Decision.POINTWISE_CALIBRATED, errors=errors) if strength == 0
-                                else None)
+                                else None, ramp_table=ramp_table_of(transfer, None) if strength > 0 else None)
         # Where the calibration found a repair safe, the regions that read as hard-edged
         # (text over the photo) get full strength: mixed scenes' graphics 0.479 -> 0.609 of
         # their edge error removed, photo regions 0.367 -> 0.365 (tuning half). Where it
@@ -410,7 +416,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                            ink_span=COMPRESSED_INK_SPAN if compression.compressed else FLAT_SPAN)
         thin = ", pure colours of thin features there" if prior is not None else ""
         return PairAnalysis(space, 1.0, why + " for textured regions, full strength for hard-edged ones" + thin,
-                            Decision.POINTWISE_CALIBRATED, prior, local=LocalStrength(strength))
+                            Decision.POINTWISE_CALIBRATED, prior, local=LocalStrength(strength),
+                            ramp_table=ramp_table_of(transfer, prior))
     # A JPEG whose grid the pixels did not show (q 90-98) reads as grain around its edges;
     # where its edge-free blocks are flat at some phase it is a drawing from a JPEG
     # (plan/compression.py): under a neighbourhood filter it goes on to the hard-edged branch

@@ -82,7 +82,7 @@ from .neighbourhood import NEIGHBOUR_OFFSETS, dot, neighbours, planes
 from .sobel import sobel_magnitude
 
 __all__ = ["PureColourPrior", "is_flat_colour", "PALETTE_SIZE", "INK_COUNT", "ON_LINE_TOLERANCE", "KEPT_CONTRAST", "EXTENSION_KEYS",
-           "SCALE_KEYS", "SHIFT_KEYS", "filtered_colour", "extend_extreme", "scale_transfer", "key_values", "shift_grey",
+           "SCALE_KEYS", "SHIFT_KEYS", "filtered_colour", "transfer_encoded", "extend_extreme", "scale_transfer", "key_values", "shift_grey",
            "rec601_grey", "fit_pure_colour_model"]
 
 #: Most palette colours kept (a uniform array in the GL pass).
@@ -416,6 +416,34 @@ def key_values(encoded, key):
     return encoded
 
 
+def transfer_encoded(encoded, key, table, keys=None):
+    """``f`` of encoded colour planes by a table: encoded too.
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (3, N)
+        sRGB-encoded colour planes.
+    key : str
+        One of :data:`EXTENSION_KEYS`.
+    table : ndarray of float32, shape (256, 3)
+        Encoded output colour per bin of the key (see :class:`PureColourPrior`).
+    keys : ndarray of float32, shape (3, N), optional
+        The table keys to read at (:func:`key_values`, perhaps clamped); default: the
+        colour's own.
+
+    Returns
+    -------
+    ndarray of float32, shape (3, N)
+    """
+    if keys is None:
+        keys = key_values(encoded, key)
+    if key in SCALE_KEYS:
+        return scale_transfer(encoded, key, table, keys[0])
+    if key in SHIFT_KEYS:
+        return np.clip(encoded + _table_at(table[:, 0], keys[0]), 0, 1).astype(np.float32)
+    return np.stack([_table_at(table[:, c], keys[c]) for c in range(3)]).astype(np.float32)
+
+
 def filtered_colour(colour, prior, blend_space, low_end=None, high_end=None):
     """``f`` of working-space colours, by the prior's table.
 
@@ -440,12 +468,7 @@ def filtered_colour(colour, prior, blend_space, low_end=None, high_end=None):
         low, high = prior.key_range()
         keys = np.where(low_end, np.maximum(keys, low[:, None]), keys)
         keys = np.where(high_end, np.minimum(keys, high[:, None]), keys).astype(np.float32)
-    if prior.key in SCALE_KEYS:
-        out = scale_transfer(encoded, prior.key, prior.table, keys[0])
-    elif prior.key in SHIFT_KEYS:
-        out = np.clip(encoded + _table_at(prior.table[:, 0], keys[0]), 0, 1).astype(np.float32)
-    else:
-        out = np.stack([_table_at(prior.table[:, c], keys[c]) for c in range(3)]).astype(np.float32)
+    out = transfer_encoded(encoded, prior.key, prior.table, keys)
     decoded = srgb_to_linear(np.clip(out, 0, 1).T).T if blend_space == "linear" else out
     return np.concatenate([decoded * alpha, alpha[None]], axis=0).astype(np.float32)
 

@@ -47,6 +47,7 @@ import numpy as np
 
 from ...spec.local_plan import FLAT_SPAN, LocalStrength, strength_map
 from ...spec.pure_colours import INK_COUNT, PALETTE_SIZE
+from ...spec.ramp_lookup import table_bends
 from ...tiling import DEFAULT_TILES
 from ..base import Capabilities, ReadyResult, RecoveryMaps
 from .classify import BlockClassifier, BlockLists, block_grid
@@ -399,8 +400,11 @@ class GLBackend:
                    "filtered_image": self._textures["filtered"]}
         uniforms = {"sigma_d": plan.sigma_d, "sigma_e": plan.sigma_e, "strength": plan.strength,
                     "untouched_span": plan.untouched_span}
+        # The ramp lookup reads the table the pure colours read, when the plan has both.
+        ramp = plan.ramp_table if plan.iterations > 0 else None
+        if prior is not None or ramp is not None:
+            sources["transfer_table"] = self._transfer_table(prior if prior is not None else ramp)
         if prior is not None:
-            sources["transfer_table"] = self._transfer_table(prior)
             uniforms.update(self._pure_colour_uniforms(prior))
         # Towards O reads the local plan's gate (its factor's second channel); a plan
         # without a local plan gets one whose factor is exactly 1.
@@ -415,6 +419,13 @@ class GLBackend:
             defines.update(self._pure_colour_defines(prior))
             # Pure colours on drawn content only, gated by the local plan's regions' weight.
             defines["PURE_GATE"] = int(local and prior.drawn_only)
+        if ramp is not None:
+            if prior is not None and (ramp.key != prior.key or not np.array_equal(ramp.table, prior.table)):
+                raise ValueError(f"the ramp lookup's table (key {ramp.key!r}) is not the pure colours' (key "
+                                 f"{prior.key!r}): the passes hold one table (aarecovery.plan.ramp gives them one)")
+            defines["TABLE_KEY"] = ramp.key_code
+            sources["original_image"] = self._textures["original"]
+            sources["transfer_bends"] = self._transfer_bends(ramp)
         with self._passes():
             if local:
                 drawn_only = prior is not None and prior.drawn_only
@@ -453,7 +464,9 @@ class GLBackend:
                 self._run_pass("keep_filtered", keep, [result], blocks=lists if live is None else live[1],
                               list_name="inactive", defines=defines)
             if plan.iterations > 0:
-                self._jacobi_steps(sources, defines, lists if live is None else live[1], plan.iterations)
+                last_input = self._jacobi_steps(sources, defines, lists if live is None else live[1], plan.iterations)
+            if ramp is not None:
+                self._ramp_lookup(sources, defines, last_input)
         self._stage("passes")
         self._ran = {"maps": maps}
 
@@ -508,6 +521,13 @@ class GLBackend:
             self._textures["transfer_table"] = self._texture((256, 1), 3, "f4")
         self._textures["transfer_table"].write(np.ascontiguousarray(prior.table, np.float32))
         return self._textures["transfer_table"]
+
+    def _transfer_bends(self, ramp):
+        """The ramp lookup's table bends (``spec.ramp_lookup.table_bends``), per run as the table."""
+        if "transfer_bends" not in self._textures:
+            self._textures["transfer_bends"] = self._texture((256, 1), 3, "f4")
+        self._textures["transfer_bends"].write(np.ascontiguousarray(table_bends(ramp.table), np.float32))
+        return self._textures["transfer_bends"]
 
     @staticmethod
     def _pure_colour_defines(prior):
@@ -574,7 +594,7 @@ class GLBackend:
         again, reading F itself. Every value a step gathers lies in a listed block, where the
         step before wrote it: in an active block (the margin of ``blocks.active_mask``), and
         with the fit's live blocks in one of those (``live_blocks.glsl`` flags the blocks of
-        both gathers).
+        both gathers). Returns the texture the last step read.
         """
         inputs = {**sources, "model_map": self._work("model")}
         if defines["JACOBI_CONSTANT"]:
@@ -582,6 +602,7 @@ class GLBackend:
         previous = self._work("iterate_a") if iterations > 1 else sources["filtered_work"]
         for step in range(2 if iterations > 1 else 1, iterations + 1):
             final = step == iterations
+            step_input = previous
             if final:
                 target = self._textures["result"]
             else:
@@ -589,6 +610,18 @@ class GLBackend:
             self._run_pass("jacobi_step", {**inputs, "previous_iterate": previous}, [target], blocks=lists,
                           list_name="active", defines={**defines, "FINAL": int(final)})
             previous = target
+        return step_input
+
+    def _ramp_lookup(self, sources, defines, last_input):
+        """The ramp lookup over F's active blocks, where it acts (F is not flat): the last step
+        again where a pixel takes it, from `last_input` (what that step read), and the lookup
+        added (``ramp_lookup.frag``)."""
+        inputs = {**sources, "model_map": self._work("model"), "previous_iterate": last_input,
+                  "filtered_image": self._textures["filtered"]}
+        if defines["JACOBI_CONSTANT"]:
+            inputs["jacobi_constant_map"] = self._work("jacobi_constant")
+        self._run_pass("ramp_lookup", inputs, [self._textures["result"]], blocks=self._block_lists("filtered"),
+                      list_name="active", defines={**defines, "FINAL": 1})
 
     @_current
     def finish(self):

@@ -43,7 +43,7 @@ __all__ = ["COMPUTE_VERSION", "SAMPLER_UNITS", "FragmentPath", "ComputePath", "c
 #: The texture unit of every sampler uniform the passes declare.
 SAMPLER_UNITS = {"original_image": 0, "filtered_image": 1, "model_map": 2, "previous_iterate": 3,
                  "original_work": 4, "filtered_work": 5, "transfer_table": 6, "jacobi_constant_map": 7,
-                 "strength_factor": 8, "local_input": 9}
+                 "strength_factor": 8, "local_input": 9, "transfer_bends": 10}
 
 
 def available_paths(context):

@@ -1,8 +1,8 @@
 // Pure colours of thin features (the safe default, point-wise filters on hard-edged content).
 // Twin: extend_extreme and filtered_colour in aarecovery/spec/pure_colours.py, which explains
 // the rule and its measurements. Included after working.glsl, before blend_model.glsl.
+#include "transfer_table.glsl"
 
-uniform sampler2D transfer_table;  // 256 x 1: the filter's table, encoded output per key bin
 uniform vec3 palette[32];          // O's flat colours, opaque, in the working space
 uniform int palette_size;
 uniform vec3 inks[16];             // O's recurring colours on the cube's faces, encoded
@@ -22,18 +22,8 @@ uniform float luma_purity;         // an extreme whose luma is within this of a 
 // The prior's switches are compile-time defines, not uniforms: llvmpipe runs both sides of
 // every branch under a mask, so a uniform switch paid for every key's sRGB conversions
 // (pow) at every fitted pixel.
-// TABLE_KEY: 0: each channel indexes its own column, 1: luma indexes all,
-//            4/5: encoded luminance (Rec. 709 / D50 weights) indexes all,
-//            2/3: luma (encoded) / luminance (linear) mapped by column 0, colour scaled
-//            with it (scale_transfer)
-//            6/7: the 8-bit Rec. 601 grey (rounded / truncated) indexes an offset added to
-//            every channel (SHIFT_KEYS, shift_grey)
-//            8: the 8-bit Rec. 601 grey, rounded, indexes all (rec601_grey)
 // CLAMP_ENDS: 1: an extreme at an end of the range reads the table clamped
 // TO_CUBE: 0: extend only to a flat colour of O beyond the extreme
-#ifndef TABLE_KEY
-#define TABLE_KEY 0
-#endif
 #ifndef CLAMP_ENDS
 #define CLAMP_ENDS 0
 #endif
@@ -46,8 +36,6 @@ uniform float luma_purity;         // an extreme whose luma is within this of a 
 #ifndef EXPLAIN_FILTERED
 #define EXPLAIN_FILTERED 1
 #endif
-#define SCALE_KEY (TABLE_KEY == 2 || TABLE_KEY == 3)
-#define SHIFT_KEY (TABLE_KEY == 6 || TABLE_KEY == 7)
 
 const float PALETTE_TOLERANCE = 0.03;
 const float LINE_TOLERANCE = 0.05;
@@ -62,32 +50,6 @@ const float MIN_CONTRAST = 8.5 / 255.0;
 const float MIN_REACH = 1.2001;
 const float INK_TOLERANCE = 2.0 / 255.0;
 const float SHORT_REACH = 1.0001;
-// The tools' fixed-point Rec. 601 Y (spec.pure_colours._OPENCV_Y, _PILLOW_Y, _REC601_Y):
-// weights and scale.
-const vec4 OPENCV_Y = vec4(4899.0, 9617.0, 1868.0, 16384.0);
-const vec4 PILLOW_Y = vec4(19.136, 37.568, 7.296, 64.0);
-const vec4 REC601_Y = vec4(299.0, 587.0, 114.0, 1000.0);
-
-float table_at(float key, int channel) {
-    // Linear interpolation between bin centres, two fetches (no texture filtering: llvmpipe's
-    // filtering weights are not exact).
-    float position = clamp(key * 256.0 - 0.5, 0.0, 255.0);
-    int lower = min(int(floor(position)), 254);
-    float fraction = position - float(lower);
-    float below = texelFetch(transfer_table, ivec2(lower, 0), 0)[channel];
-    float above = texelFetch(transfer_table, ivec2(lower + 1, 0), 0)[channel];
-    return below + (above - below) * fraction;
-}
-
-// Every column at one key: two fetches instead of six, the same arithmetic per column.
-vec3 table_row_at(float key) {
-    float position = clamp(key * 256.0 - 0.5, 0.0, 255.0);
-    int lower = min(int(floor(position)), 254);
-    float fraction = position - float(lower);
-    vec3 below = texelFetch(transfer_table, ivec2(lower, 0), 0).rgb;
-    vec3 above = texelFetch(transfer_table, ivec2(lower + 1, 0), 0).rgb;
-    return below + (above - below) * fraction;
-}
 
 vec3 encoded_of(vec4 colour) {
     float coverage = colour.a;
@@ -99,59 +61,11 @@ vec3 encoded_of(vec4 colour) {
 #endif
 }
 
-// The table keys of an encoded colour, one per table column (key_values).
-vec3 key_values(vec3 encoded) {
-#if TABLE_KEY == 0
-    return encoded;
-#elif SHIFT_KEY
-    // The grey level as the tool computes it from the 8-bit channels, at its bin's centre
-    // (shift_grey): whole numbers below 2^24, exact in float.
-    vec3 levels = floor(clamp(encoded, 0.0, 1.0) * 255.0 + 0.5);
-#if TABLE_KEY == 6
-    float grey = floor((levels.r * OPENCV_Y.x + levels.g * OPENCV_Y.y + levels.b * OPENCV_Y.z + OPENCV_Y.w / 2.0)
-                       / OPENCV_Y.w);
-#else
-    float grey = floor((floor(levels.r * PILLOW_Y.x + 0.5) + floor(levels.g * PILLOW_Y.y + 0.5)
-                        + floor(levels.b * PILLOW_Y.z + 0.5)) / PILLOW_Y.w);
-#endif
-    grey = clamp(grey, 0.0, 255.0);
-    return vec3((grey + 0.5) / 256.0);
-#elif TABLE_KEY == 8
-    // The rounded grey in thousandths (rec601_grey): whole numbers, exact in float.
-    vec3 levels = floor(clamp(encoded, 0.0, 1.0) * 255.0 + 0.5);
-    float grey = floor((levels.r * REC601_Y.x + levels.g * REC601_Y.y + levels.b * REC601_Y.z + REC601_Y.w / 2.0)
-                       / REC601_Y.w);
-    grey = clamp(grey, 0.0, 255.0);
-    return vec3((grey + 0.5) / 256.0);
-#elif TABLE_KEY == 4 || TABLE_KEY == 5
-    // The encoded value of the luminance of linear light (LUMINANCE_KEYS).
-    vec3 weights = TABLE_KEY == 4 ? LUMA : LUMINANCE_D50;
-    vec3 lin = srgb_to_linear(encoded);
-    return linear_to_srgb(vec3(lin.r * weights.r + lin.g * weights.g + lin.b * weights.b));
-#else
-    vec3 values = TABLE_KEY == 3 ? srgb_to_linear(encoded) : encoded;
-    return vec3(values.r * LUMA.r + values.g * LUMA.g + values.b * LUMA.b);
-#endif
-}
-
 // f of a premultiplied working-space colour whose encoded colour and (clamped) table keys
 // are known.
 vec4 filtered_colour_of(vec4 colour, vec3 encoded, vec3 keys) {
     float coverage = colour.a;
-#if SCALE_KEY
-    vec3 values = TABLE_KEY == 3 ? srgb_to_linear(encoded) : encoded;
-    float luma = values.r * LUMA.r + values.g * LUMA.g + values.b * LUMA.b;
-    float mapped = table_at(keys.r, 0);
-    vec3 scaled = luma > 1e-6 ? values * (mapped / luma) : vec3(mapped);
-    scaled = clamp(scaled, 0.0, 1.0);
-    vec3 out_colour = TABLE_KEY == 3 ? linear_to_srgb(scaled) : scaled;
-#elif SHIFT_KEY
-    vec3 out_colour = clamp(encoded + vec3(table_at(keys.r, 0)), 0.0, 1.0);
-#elif TABLE_KEY == 0
-    vec3 out_colour = vec3(table_at(keys.r, 0), table_at(keys.g, 1), table_at(keys.b, 2));
-#else
-    vec3 out_colour = table_row_at(keys.r);  // one key for all columns
-#endif
+    vec3 out_colour = transfer_encoded(encoded, keys);
 #if WORK_IS_LINEAR
     vec3 decoded = srgb_to_linear(clamp(out_colour, 0.0, 1.0));
 #else
