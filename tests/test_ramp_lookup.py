@@ -192,6 +192,11 @@ def test_gl_agrees_with_numpy(gl_path, lettered):
                 run.run(plan)
             differences.append(result_difference(engine.result(), reference_engine.result()))
         assert differences[0] <= max(differences[1], 1e-5) + 1e-5, differences
+        # 16-bit and grey pairs (grey is expanded to RGB at the edges and folded back).
+        for pair in ((original.astype(np.uint16) * 257, filtered.astype(np.uint16) * 257),
+                     (original[..., 1].copy(), filtered[..., 1].copy())):
+            assert_results_agree(aarecovery.recover(*pair, engine=engine), aarecovery.recover(*pair, backend="numpy"))
+            assert engine.last_plan.ramp_table is not None
         # With alpha: the lookup only where O is opaque around the pixel.
         alpha = np.full(original.shape[:2] + (1,), 255, np.uint8)
         alpha[10:30, 40:70] = 128
