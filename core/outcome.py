@@ -61,9 +61,11 @@ class RecoverySummary:
         if plan.keeps_filtered:
             return f"returned F unchanged ({plan.mode} mode, {plan.decision}): {plan.reason}; {_forcing(plan, force)}"
         pure = ", pure colours of thin features" if plan.pure_colours is not None else ""
+        ramps = ", the filter's steps antialiased across smooth gradients" if plan.ramp_table is not None else ""
         what = ("repaired the edges" if self.edge_share is None else
                 f"repaired {self.edge_share:.0%} of the edge pixels ({self.changed_pixels} pixels changed)")
-        return f"{what} in {plan.mode} mode ({plan.decision}): {self._strength()}, blend in {plan.blend_space}{pure}"
+        return (f"{what} in {plan.mode} mode ({plan.decision}): {self._strength()}, blend in {plan.blend_space}"
+                f"{pure}{ramps}")
 
     def _strength(self):
         plan = self.plan

@@ -142,6 +142,9 @@ def test_the_safe_default_takes_it_for_a_posterized_photo_not_for_a_drawing_or_l
     engine.set_images(original, filtered)
     plan = engine.plan()
     assert plan.decision == Decision.POINTWISE_CALIBRATED and plan.ramp_table.key == "channel"
+    engine.run(plan)
+    line = aarecovery.summarize_recovery(plan, original, filtered, engine.result()).line()
+    assert line.endswith(", the filter's steps antialiased across smooth gradients"), line
     assert engine.plan(mode="paper").ramp_table is None
     engine.set_images(original / np.float32(255), filtered / np.float32(255), linear=True)
     assert engine.plan().ramp_table is None

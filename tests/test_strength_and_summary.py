@@ -70,7 +70,9 @@ def test_summary_counts_the_changed_pixels_and_names_the_plan(threshold_pair, ba
     plan = summary.plan
     assert summary.line() == (f"repaired {summary.edge_share:.0%} of the edge pixels ({changed} pixels changed) in "
                               f"safe mode ({plan.decision}): strength {plan.strength:g}, blend in {plan.blend_space}"
-                              + (", pure colours of thin features" if plan.pure_colours is not None else ""))
+                              + (", pure colours of thin features" if plan.pure_colours is not None else "")
+                              + (", the filter's steps antialiased across smooth gradients"
+                                 if plan.ramp_table is not None else ""))
 
 
 def test_summary_of_a_kept_f_says_why_and_what_forcing_risks(blur_pair):
