@@ -146,14 +146,26 @@ _GREY_TEXTURED_STRENGTH = 0.25
 # filters colour photos lose even at 0.1 (tuning half: hubble under GEGL's hue-chroma -0.13,
 # coffee under OpenCV's bilateral at q 95 -0.01) and keep F.
 _SHARPENED_COLOUR_STRENGTH = 0.1
+# ... but a JPEG original's colour image under a sharpening filter takes more. What bounds
+# 0.1 is a lossless photo downscaled in sRGB values, whose filter leaves little to repair;
+# a JPEG's grain is partly its compression noise, which the mask sharpens beside the edges
+# as the reference does, and the drawings whose noise reads as grain (maps, icons, the star
+# burst, memo) are no photos. Tuning half, the 19 colour JPEG cases under the two unsharp
+# masks read as textured, mean edge-band error reduction by strength 0.1 / 0.25 / 0.5 / 1:
+# 0.101 / 0.153 / 0.158 / 0.016 (at 0.25 every case up but the icons at q 75, 0.008 ->
+# -0.005; at 0.5 the photos fall: hubble under GEGL's mask at q 98 0.213 -> 0.029, coffee
+# under ImageMagick's below F).
+_COMPRESSED_SHARPENED_COLOUR_STRENGTH = 0.25
 
 
-def _textured_strength(grey, smoothing):
+def _textured_strength(grey, smoothing, compressed):
     """The strength for a textured image (or a photo's regions) under a neighbourhood filter
     that is no colour map: 0 keeps F."""
     if grey:
         return _GREY_TEXTURED_STRENGTH
-    return _PHOTO_NEIGHBOURHOOD_STRENGTH if smoothing else _SHARPENED_COLOUR_STRENGTH
+    if smoothing:
+        return _PHOTO_NEIGHBOURHOOD_STRENGTH
+    return _COMPRESSED_SHARPENED_COLOUR_STRENGTH if compressed else _SHARPENED_COLOUR_STRENGTH
 
 
 # The reasons' note of a smoothing filter's untouched edges (plan/smoothing.py).
@@ -454,7 +466,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
             # (every filter) 4 -> 2 and their mean 0.211 -> 0.244, text and graphics 0.484 -> 0.490.
             sharpening = contrast_ratio(o, f, edges)
             smoothing = sharpening < SMOOTHED_CONTRAST
-            photo_strength = 0.0 if smoothing else _textured_strength(grey, smoothing=False)
+            photo_strength = 0.0 if smoothing else _textured_strength(grey, False, compression.compressed)
             drawn = drawn_share(o, edges)
             if drawn >= MIXED_DRAWN_SHARE:
                 ratio = _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e)
@@ -491,12 +503,14 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                         Decision.NEIGHBOURHOOD_MIXED, prior, local=LocalStrength(photo_strength),
                                         untouched_span=UNTOUCHED_SPAN if smoothing else 0.0,
                                         toward_original=toward)
-            strength = _textured_strength(grey, smoothing)
+            strength = _textured_strength(grey, smoothing, compression.compressed)
             if strength > 0:
                 return PairAnalysis(space, strength,
                                     f"{'smoothing' if smoothing else 'sharpening'} filter on a "
                                     f"{'grey ' if grey else ''}textured image ({texture}; F's edge contrast "
-                                    f"{sharpening:.2f} times O's): strength {strength:g}",
+                                    f"{sharpening:.2f} times O's): strength {strength:g}"
+                                    + (f" above {compression.describe()}"
+                                       if strength == _COMPRESSED_SHARPENED_COLOUR_STRENGTH and not grey else ""),
                                     Decision.NEIGHBOURHOOD_TEXTURED)
             return PairAnalysis(space, strength,
                                 f"neighbourhood filter on a textured image ({texture}): "
