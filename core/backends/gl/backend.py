@@ -499,8 +499,9 @@ class GLBackend:
                  (last_inputs, "strength_factor", "active"))
         for number, (inputs, output, list_name) in enumerate(steps, 1):
             where = {} if blocks is None else {"blocks": blocks[0], "list_name": list_name}
-            uniforms = {"textured": local.textured, "drawn_ink": int(local.drawn_ink), "ink_gate_span": float(ink_span)}
-            beta_only = {"FACTOR_FOR_BETA": int(for_beta), "INK_GATE": int(ink_gate)} if number == 3 else {}
+            uniforms = {"textured": local.textured, "ink_gate_span": float(ink_span)}
+            beta_only = ({"FACTOR_FOR_BETA": int(for_beta), "DRAWN_INK": int(local.drawn_ink), "INK_GATE": int(ink_gate)}
+                         if number == 3 else {})
             self._run_pass("local_plan", inputs, [self._work(output)], uniforms=uniforms,
                           defines={**defines, **beta_only, "LOCAL_PASS": number}, **where)
         self._factor_for = (local, ink_gate, ink_span, for_beta, blocks and blocks[1])

@@ -1,15 +1,24 @@
 // The local plan's factor of beta, in three passes over the whole image, each reading the
 // last (LOCAL_PASS 1, 2, 3): O's flat pixels, their sums along rows, then the sums along
 // columns, the region's flat share, the pixel's drawn ink (read from O) and the factor.
-// INK_GATE (pass 3): the drawn ink opens the gate of pure colours too. A define, not a
-// uniform: without it the gate's counts are not compiled into the 49-texel loop, which
-// llvmpipe runs line by line for every pixel whose F varies (the 4096 x 4096 photo pair's
-// pass 3, pass clock, three processes of each in turn: 0.41-0.50 -> 0.34-0.46 s).
+// DRAWN_INK and INK_GATE (pass 3): the drawn ink counts as hard-edged for the strength, and
+// opens the gate of pure colours too. Defines, not uniforms: without one, its counts are not
+// compiled into the 49-texel loop, which llvmpipe runs line by line for every pixel whose F
+// varies (the 4096 x 4096 photo pair's pass 3 without the gate, pass clock, three processes
+// of each in turn: 0.41-0.50 -> 0.34-0.46 s).
 // Twin: flat_pixels, flat_share, hard_edged_weight, ink_weight and LocalStrength.factor in
 // aarecovery/spec/local_plan.py. With
 // LOCAL_ENCODE the uploaded O is linear light and is sRGB-encoded first. With
 // FACTOR_FOR_BETA, pass 3 counts no drawn ink where F is flat around the pixel (below).
 // Needs colour.glsl.
+
+// Pass 3's switches, off in passes 1 and 2 (which compile ink_weight but never call it).
+#ifndef DRAWN_INK
+#define DRAWN_INK 0
+#endif
+#ifndef INK_GATE
+#define INK_GATE 0
+#endif
 
 const float FLAT_SPAN = 0.5 / 255.0;
 const int REGION_RADIUS = 8;
@@ -32,7 +41,6 @@ const float LUMA_TIE = 0.00005 / 255.0;
 uniform sampler2D original_image;  // O as uploaded (passes 1 and 3)
 uniform sampler2D local_input;     // the previous pass's output (passes 2 and 3)
 uniform float textured;            // the factor in textured regions (pass 3)
-uniform int drawn_ink;             // 1: drawn ink counts as hard-edged too (pass 3)
 uniform float ink_gate_span;       // within what the gate's ink recurs: FLAT_SPAN, wider on a JPEG (pass 3)
 #if FACTOR_FOR_BETA
 uniform sampler2D filtered_image;  // F as uploaded (pass 3)
@@ -92,10 +100,12 @@ vec2 ink_weight(ivec2 p, ivec2 size, bool needed) {
             vec3 d0 = abs(c - brightest);
             vec3 d1 = abs(c - darkest);
             vec2 distance = vec2(max(d0.r, max(d0.g, d0.b)), max(d1.r, max(d1.g, d1.b)));
+#if DRAWN_INK
             ivec2 is_near = ivec2(lessThanEqual(distance, vec2(INK_NEAR_SPAN)));
             ivec2 is_equal = ivec2(lessThanEqual(distance, vec2(FLAT_SPAN)));
             equal += is_equal;
             near += (1 - is_equal) * is_near;
+#endif
 #if INK_GATE
 #if INK_BY_LUMA
             vec2 gate_distance = mix(distance, abs(vec2(dot(c, LUMA)) - ink_luma) - LUMA_TIE, by_luma);
@@ -115,11 +125,11 @@ vec2 ink_weight(ivec2 p, ivec2 size, bool needed) {
         vec3 other = side == 0 ? darkest : brightest;
         // The strength's test, then the gate's (fewer recurrences, within its span).
         bool bright = max(ink.r, max(ink.g, ink.b)) > INK_DARK;
+        bvec2 drawn = bvec2(DRAWN_INK != 0 && bright && 2 * near[side] <= equal[side] && equal[side] >= INK_REPEATS,
 #if INK_GATE
-        bvec2 drawn = bvec2(bright && 2 * near[side] <= equal[side] && equal[side] >= INK_REPEATS,
                             bright && 2 * gate_near[side] <= gate_equal[side] && gate_equal[side] >= INK_GATE_REPEATS);
 #else
-        bvec2 drawn = bvec2(bright && 2 * near[side] <= equal[side] && equal[side] >= INK_REPEATS, false);
+                            false);
 #endif
         vec3 across = other - ink;
         vec3 from_ink = centre - ink;
@@ -189,8 +199,8 @@ vec2 local_plan(ivec2 p, ivec2 size) {
     needed = !filtered_flat;
 #endif
     // The ink is at most 1: at a full region weight it changes neither value.
-    vec2 ink = (drawn_ink != 0 || INK_GATE != 0) && region < 1.0 ? ink_weight(p, size, needed) : vec2(0.0);
-    float weight = drawn_ink != 0 ? max(region, ink.x) : region;
+    vec2 ink = (DRAWN_INK != 0 || INK_GATE != 0) && region < 1.0 ? ink_weight(p, size, needed) : vec2(0.0);
+    float weight = DRAWN_INK != 0 ? max(region, ink.x) : region;
     float gate = INK_GATE != 0 ? max(region, ink.y) : region;
     return vec2(textured + (1.0 - textured) * weight, gate);
 #endif
