@@ -141,9 +141,10 @@ def test_a_light_grain_that_the_filter_makes_coarse_is_repaired_as_a_coarse_one(
 def test_a_sharpened_coarse_grain_keeps_its_sharpening_on_the_bare_paper():
     """An unsharp mask sharpens a coarse paper grain, and the reference keeps it sharpened:
     at the user's sigma_e the repair took it back beside the letters (haze: paper made darker
-    than F). At the grain's sigma_e the haze falls by over half; blended in linear light
-    (the grain keeps the strokes from their pure colours) the letters gain more than in
-    the sRGB values the page was antialiased in."""
+    than F). At the grain's sigma_e the haze falls by over half. The mask keeps the paper's
+    mean, so the strokes get their pure colours, blended in the sRGB values the grain was
+    sharpened in: the letters gain more than in linear light, with less haze (measured 0.63
+    and 526 pixels against 0.58 and 888)."""
     from dataclasses import replace
 
     from aarecovery.lab import realtools
@@ -155,19 +156,20 @@ def test_a_sharpened_coarse_grain_keeps_its_sharpening_on_the_bare_paper():
     plan = recover_no_worse_than_f(case)
     assert plan.decision == Decision.NEIGHBOURHOOD_HARD_EDGED and plan.strength == 1, plan.reason
     assert plan.sigma_e == pytest.approx(SIGMA_E.default * GRAIN_EDGE_SCALE), plan.reason
-    assert plan.blend_space == "linear", plan.reason
+    assert plan.blend_space == "srgb" and plan.pure_colours is not None, plan.reason
     band = edge_band(case.original, case.filtered, case.reference)
     measured = {}
     with aarecovery.Engine("numpy") as engine:
         engine.set_images(case.original, case.filtered)
         for name, variant in (("plan", plan), ("user's sigma_e", replace(plan, sigma_e=SIGMA_E.default)),
-                              ("sRGB", replace(plan, blend_space="srgb"))):
+                              ("linear light", replace(plan, blend_space="linear"))):
             engine.run(variant)
             result = engine.result()[..., :3]
             measured[name] = (haze_pixels(result, case.filtered, case.paper),
                               error_reduction(result, case.filtered, case.reference, band))
     assert measured["user's sigma_e"][0] > 20 and measured["plan"][0] < measured["user's sigma_e"][0] / 2, measured
-    assert measured["plan"][1] > measured["sRGB"][1] + 0.1, measured
+    assert measured["plan"][1] > measured["linear light"][1] + 0.02, measured
+    assert measured["plan"][0] < measured["linear light"][0], measured
 
 
 def test_the_grains_sigma_e_stays_below_the_letters_edge_strength_under_a_solarize():
@@ -192,3 +194,35 @@ def test_the_grains_sigma_e_stays_below_the_letters_edge_strength_under_a_solari
             reductions.append(error_reduction(engine.result()[..., :3], case.filtered, case.reference, band))
     capped, uncapped = reductions
     assert capped > 0.5 and capped > uncapped + 0.1, reductions
+
+
+@pytest.mark.parametrize("filter_name", ["bilateral", "unsharp"])
+def test_a_grained_page_under_a_filter_that_keeps_its_paper_gets_pure_colours(filter_name):
+    """A scanned page's grain leaves no flat pixel, but a sharpening or edge-aware smoothing
+    filter keeps the paper's local mean: the identity is its table there, and the letters'
+    thin strokes get their pure colours (plan/flat_colours.py, paper_kept_share)."""
+    import dataclasses
+
+    from aarecovery import filters
+    from aarecovery.lab.metrics import error_reduction
+
+    k = FAMILIES["memo"].k
+    scene = render_family("memo", 96)
+    original = _quantised(box_downsample(scene, k, "srgb"))
+    spec = filters.get_filter(filter_name)
+    parameters = spec.defaults()
+    filtered = _quantised(filters.apply(filter_name, original, **parameters))
+    reference = box_downsample(filters.apply(filter_name, scene, scale=k, **parameters), k, "srgb")
+    assert paper_grain(original).span > 0
+    band = edge_band(original, filtered, reference)
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(original, filtered)
+        plan = engine.plan()
+        assert plan.pure_colours is not None and "the paper's mean kept" in plan.reason, plan.reason
+        engine.run(plan)
+        with_prior = error_reduction(engine.result(), filtered, reference, band)
+        engine.run(dataclasses.replace(plan, pure_colours=None))
+        without = error_reduction(engine.result(), filtered, reference, band)
+    # Measured: bilateral 0.76 (0.70 without the prior), unsharp 0.78 (0.66); before the
+    # paper's mean was read, both kept the paper's passes (no prior).
+    assert with_prior > without + 0.03, (with_prior, without)

@@ -88,7 +88,8 @@ from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
 from .mixed_content import COMPRESSED_INK_SPAN, MIXED_DRAWN_SHARE, drawn_only, drawn_share
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
-from .paper_grain import GRAINED_NEIGHBOURHOOD_STRENGTH, SHARPENED_GRAIN_BLEND_SPACE, grain_edge_scale, paper_grain
+from .paper_grain import (GRAINED_NEIGHBOURHOOD_STRENGTH, SHARPENED_GRAIN_BLEND_SPACE, SHARPENED_GRAIN_PURE_BLEND_SPACE,
+                          grain_edge_scale, paper_grain)
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import COMPRESSED_LUMA_PURITY, pure_colour_prior
 from .ramp import ramp_table_of
@@ -563,7 +564,7 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                             Decision.NEIGHBOURHOOD_HARD_EDGED, edge_scale=grain.edge_scale, **untouched)
     # Filters that keep flat colours (sharpening, edge-aware smoothing): thin features get
     # their pure colours with the identity as the table (plan/flat_colours.py).
-    prior, kept = flat_colour_prior(o, f, edges)
+    prior, kept = flat_colour_prior(o, f, edges, grain)
     pure = f", pure colours of thin features ({kept})" if prior is not None else ""
     why = f"neighbourhood filter on hard-edged content (repair-to-error ratio {ratio:.1f})"
     # Where it keeps O's colours (the prior: its flat areas and colour lines; every flat pixel)
@@ -599,7 +600,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # (SHARPENED_GRAIN_BLEND_SPACE says why).
     if grain.coarse:
         # The blend space is named by the summary line (a user's --blend-space overrides it).
-        return PairAnalysis(SHARPENED_GRAIN_BLEND_SPACE, 1.0, why + f" that sharpens {grain.describe()}: full "
+        space = SHARPENED_GRAIN_BLEND_SPACE if prior is None else SHARPENED_GRAIN_PURE_BLEND_SPACE
+        return PairAnalysis(space, 1.0, why + f" that sharpens {grain.describe()}: full "
                                                                "strength at the grain's edge scale" + pure,
                             Decision.NEIGHBOURHOOD_HARD_EDGED, prior, edge_scale=grain.edge_scale)
     # On a JPEG a sharpening filter blends in sRGB values (see COMPRESSED_SHARPENED_BLEND_SPACE).

@@ -38,9 +38,9 @@ from ..colour import LUMA
 from ..spec import to_working_space
 from ..spec.blend_model import edge_strength
 
-__all__ = ["PaperGrain", "paper_grain", "grain_edge_scale", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN", "FILTERED_GRAIN_SPAN",
-           "GRAIN_EDGE_SCALE", "GRAIN_EDGE_SHARE", "SHARPENED_GRAIN_BLEND_SPACE", "MAX_GRAIN_SPAN",
-           "GRAINED_NEIGHBOURHOOD_STRENGTH"]
+__all__ = ["PaperGrain", "paper_grain", "paper_pixels", "grain_edge_scale", "GRAIN_SPAN_FACTOR", "COARSE_GRAIN_SPAN",
+           "FILTERED_GRAIN_SPAN", "GRAIN_EDGE_SCALE", "GRAIN_EDGE_SHARE", "SHARPENED_GRAIN_BLEND_SPACE",
+           "SHARPENED_GRAIN_PURE_BLEND_SPACE", "MAX_GRAIN_SPAN", "GRAINED_NEIGHBOURHOOD_STRENGTH"]
 
 #: The pure colours' contrast floor, in multiples of the quiet pixels' 3 x 3 luma span.
 #: Tuning half, scans under levels, equalization, posterize and thresholds (memo and notice,
@@ -85,6 +85,14 @@ GRAINED_NEIGHBOURHOOD_STRENGTH = 0.5
 #: 0.345 / 1408 px, at 3 times it 0.332 / 206; linear light at 3, 5 and 10 times 0.496 /
 #: 1116, 0.474 / 461, 0.429 / 146 (the paper's method 0.518 / 3946).
 SHARPENED_GRAIN_BLEND_SPACE = "linear"
+#: ... but where the filter keeps the paper's mean and the strokes get their pure colours
+#: (``plan.flat_colours.paper_kept_share``), the reason for linear light is gone, and the
+#: grain, sharpened in the encoded values, is blended there: tuning half, the 11 cases of
+#: memo and notice (PNG and JPEG) under the two tuning unsharp masks that take the prior,
+#: mean edge error reduction / paper pixels darker than F: linear light 0.669 / 10978,
+#: sRGB values 0.693 / 5862 (memo at q 85 0.777 -> 0.845; the linear-light notice PNG 0.01
+#: lower).
+SHARPENED_GRAIN_PURE_BLEND_SPACE = "srgb"
 #: A quiet span above this is no paper grain but content with no flat pixel: the built-in
 #: suite's dense lines span 67 (linear) and 115 (sRGB) levels there, and with their quiet
 #: span as a grain lost their pure colours (quick suite 0.792 -> 0.693 linear).
@@ -151,6 +159,14 @@ def paper_grain(encoded, filtered=None):
         return PaperGrain(0.0)
     filtered_span = 0.0 if filtered is None else float(np.median(_luma_span(filtered)[span <= quiet]))
     return PaperGrain(quiet, filtered_span)
+
+
+def paper_pixels(encoded, grain):
+    """bool ``(H, W)``: O's quiet pixels, the bare paper, whose 3 x 3 luma span is at most the
+    grain's (:attr:`PaperGrain.span`; none where it is 0)."""
+    if grain.span <= 0:
+        return np.zeros(encoded.shape[:2], bool)
+    return _luma_span(encoded) <= np.float32(grain.span)
 
 
 def grain_edge_scale(grain, encoded, filtered, edges, blend_space, sigma_e):
