@@ -597,7 +597,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                             Decision.NEIGHBOURHOOD_HARD_EDGED, prior, **untouched)
     # A sharpening filter on a coarse grain sharpens the grain too: the passes run at the
     # grain's sigma_e, so that the bare paper keeps it, blended in linear light
-    # (SHARPENED_GRAIN_BLEND_SPACE says why).
+    # (SHARPENED_GRAIN_BLEND_SPACE says why), or in sRGB values where the strokes have their
+    # pure colours (SHARPENED_GRAIN_PURE_BLEND_SPACE).
     if grain.coarse:
         # The blend space is named by the summary line (a user's --blend-space overrides it).
         space = SHARPENED_GRAIN_BLEND_SPACE if prior is None else SHARPENED_GRAIN_PURE_BLEND_SPACE

@@ -27,7 +27,10 @@ pages 38-39 levels). So:
   weak edges too (a solarize), the scale stops at their edge strength
   (:func:`grain_edge_scale`);
 * a sharpening filter on a coarse grain sharpens the grain too: full strength at the
-  grain's ``sigma_e``, blended in linear light (:data:`SHARPENED_GRAIN_BLEND_SPACE`).
+  grain's ``sigma_e``, blended in linear light (:data:`SHARPENED_GRAIN_BLEND_SPACE`), or in
+  sRGB values where the filter keeps the paper's mean and the strokes take their pure
+  colours (:data:`SHARPENED_GRAIN_PURE_BLEND_SPACE`; :func:`paper_pixels` is the paper
+  that ``plan.flat_colours.paper_kept_share`` reads).
 """
 
 from dataclasses import dataclass
