@@ -4,6 +4,7 @@ The tolerances are in one table, ``tests/parity.py``: the working-space textures
 relative (float32 rounding of the same sRGB formula), the maps and the final R by dtype.
 """
 
+import dataclasses
 import io
 
 import numpy as np
@@ -254,6 +255,39 @@ def test_pure_colours_agree_at_the_floor_of_a_jpegs_noise_contrast(gl_engine):
     assert gl_engine.last_plan.pure_colours.noise_contrast == MIN_NOISE_CONTRAST
     expected = aarecovery.recover(original, filtered, backend="numpy")
     assert np.abs(actual.astype(np.int64) - expected).max() <= 1
+
+
+@pytest.mark.parametrize("ink_count", [1, 2, 3, 5, 16])
+def test_the_seen_ink_test_agrees_at_every_compiled_length(gl_engine, ink_count):
+    # The GL loop over O's inks is compiled to the fewest of a few lengths that hold them
+    # (INK_SLOTS), its spare slots holding no colour. Serif text in green ink under the cube
+    # curve, where the green ink that O shows decides (test_pure_colours), first of `ink_count`
+    # inks; the others lie on the cube's faces far from every colour of the scene.
+    from aarecovery.lab.realtools import FAMILIES, render_family
+    from aarecovery.plan.resample import box_downsample
+    from aarecovery.spec.pure_colours import INK_COUNT
+    scene = np.rint(render_family("serif", 96) * 255).astype(np.uint8)
+    original = np.rint(box_downsample(scene.astype(np.float32) / 255, FAMILIES["serif"].k, "srgb") * 255
+                       ).astype(np.uint8)
+    filtered = np.rint(np.minimum(original.astype(np.float64) ** 3, 255)).astype(np.uint8)
+    engines = {"numpy": aarecovery.Engine("numpy"), "gl": gl_engine}
+    plan = engines["numpy"].set_images(original, filtered) or engines["numpy"].plan()
+    green = np.float32([0, 89, 38]) / 255
+    assert np.abs(plan.pure_colours.inks - green).max(axis=1).min() < 0.5 / 255
+    others = np.float32([[1, 1, 0.5 + step / 64] for step in range(INK_COUNT)])
+    results = {}
+    for inks in (green[None], np.concatenate([green[None], others])[:ink_count]):
+        tried = dataclasses.replace(plan, pure_colours=dataclasses.replace(plan.pure_colours, inks=inks))
+        for name, engine in engines.items():
+            engine.set_images(original, filtered)
+            engine.run(tried)
+            results[name, len(inks)] = engine.result()
+    assert_results_agree(results["gl", ink_count], results["numpy", ink_count])
+    # The spare inks change nothing; without the green ink the result would differ.
+    np.testing.assert_array_equal(results["gl", ink_count], results["gl", 1])
+    without = dataclasses.replace(plan, pure_colours=dataclasses.replace(plan.pure_colours, inks=green[:0]))
+    gl_engine.run(without)
+    assert np.abs(gl_engine.result().astype(np.int64) - results["gl", 1]).max() > 16
 
 
 def _sparse_pair():

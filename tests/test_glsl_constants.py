@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from aarecovery import colour
-from aarecovery.backends.gl import blocks
+from aarecovery.backends.gl import backend, blocks
 from aarecovery.backends.gl.glsl import read_source
 from aarecovery.spec import blend_model, local_plan, pure_colours, ramp_lookup, working_space
 
@@ -83,8 +83,10 @@ def test_palette_array_holds_the_palette_size():
     assert f"uniform vec3 palette[{pure_colours.PALETTE_SIZE}];" in read_source("pure_colours.glsl")
 
 
-def test_ink_array_holds_the_ink_count():
-    assert f"uniform vec3 inks[{pure_colours.INK_COUNT}];" in read_source("pure_colours.glsl")
+def test_the_longest_ink_loop_holds_the_ink_count():
+    # The array and its loop are INK_SLOTS long, one of the backend's compiled lengths.
+    assert "uniform vec3 inks[INK_SLOTS];" in read_source("pure_colours.glsl")
+    assert max(backend._INK_SLOT_COUNTS) == pure_colours.INK_COUNT
 
 
 def test_em_iterations_match():

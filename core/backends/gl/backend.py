@@ -74,6 +74,19 @@ _WORK_TEXTURES = {"original_work": (4, "f4"), "filtered_work": (4, "f4"), "model
 _RESULT_BITS = {np.dtype(np.uint8): 8, np.dtype(np.uint16): 16}
 # The storage-buffer binding of the fit's live-block flags (live_blocks.glsl).
 _LIVE_FLAGS = 6
+# The seen-ink test's compiled lengths (INK_SLOTS in pure_colours.glsl): few programs, each
+# looping a constant number of times (no 1: moderngl writes an array of one as a plain
+# vec3); a slot past O's inks holds _NO_INK, which no encoded colour (0 to 1) comes within
+# INK_TOLERANCE of.
+_INK_SLOT_COUNTS = (0, 2, 4, 8, INK_COUNT)
+_NO_INK = 4.0
+
+
+def _ink_slots(prior):
+    """The fewest of _INK_SLOT_COUNTS that hold the prior's inks."""
+    count = 0 if prior.inks is None else len(prior.inks)
+    return min(slots for slots in _INK_SLOT_COUNTS if slots >= count)
+
 
 #: How a texture of 1 to 4 channels reads as straight RGBA: the texture unit expands grey
 #: and RGB for free, where a CPU expansion to RGBA cost more than the upload itself.
@@ -533,19 +546,19 @@ class GLBackend:
     def _pure_colour_defines(prior):
         """The prior's switches, compiled in (pure_colours.glsl says why)."""
         return dict(TABLE_KEY=prior.key_code, CLAMP_ENDS=int(prior.key_low is not None), TO_CUBE=int(prior.to_cube),
-                    EXPLAIN_FILTERED=int(prior.explain_filtered))
+                    EXPLAIN_FILTERED=int(prior.explain_filtered), INK_SLOTS=_ink_slots(prior))
 
     def _pure_colour_uniforms(self, prior):
         """The palette and the table's key range as uniforms."""
         palette = np.zeros((PALETTE_SIZE, 3), np.float32)
         colours = prior.palette_in(self._blend_space)
         palette[:len(colours)] = colours
-        inks = np.zeros((INK_COUNT, 3), np.float32)
-        seen = np.zeros((0, 3), np.float32) if prior.inks is None else np.asarray(prior.inks, np.float32)
-        inks[:len(seen)] = seen
+        inks = np.full((_ink_slots(prior), 3), _NO_INK, np.float32)
+        if len(inks):
+            inks[:len(prior.inks)] = prior.inks
         low, high = prior.key_range()
         return dict(palette_size=len(colours), palette=[tuple(map(float, colour)) for colour in palette],
-                    ink_count=len(seen), inks=[tuple(map(float, colour)) for colour in inks],
+                    inks=[tuple(map(float, colour)) for colour in inks],
                     key_low=tuple(map(float, low)), key_high=tuple(map(float, high)),
                     noise_contrast=float(prior.noise_contrast), ridge_noise=float(prior.ridge_noise),
                     luma_purity=float(prior.luma_purity))

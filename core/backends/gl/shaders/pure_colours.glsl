@@ -5,8 +5,17 @@
 
 uniform vec3 palette[32];          // O's flat colours, opaque, in the working space
 uniform int palette_size;
-uniform vec3 inks[16];             // O's recurring colours on the cube's faces, encoded
-uniform int ink_count;
+// INK_SLOTS: the seen-ink test's length, compiled in: the fewest of _INK_SLOT_COUNTS
+// (backends/gl/backend.py) that hold O's inks, the slots past them holding a colour that no
+// encoded colour comes near. A loop whose length is a uniform cost llvmpipe a quarter of the fit on the
+// thin-features pair at 4096^2 (1.43-1.79 -> 1.15-1.50 s, alternating runs), where a loop of
+// 16 slots with a uniform guard cost as much as that uniform loop.
+#ifndef INK_SLOTS
+#define INK_SLOTS 0
+#endif
+#if INK_SLOTS > 0
+uniform vec3 inks[INK_SLOTS];      // O's recurring colours on the cube's faces, encoded
+#endif
 uniform vec3 key_low;              // O's key range (bin centres of the table's first and last
 uniform vec3 key_high;             // filled bins, per column); beyond it the table is extrapolated
 uniform float noise_contrast;      // O's compression noise as a contrast (0: not compressed)
@@ -204,10 +213,12 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
         // stopped the extension, or the cube's point is one of O's inks.
         bool seen = nearest < 1e5 && nearest <= cube_reach;
         vec3 pure_encoded = encoded_of(near + reach * span);
-        for (int i = 0; i < ink_count; ++i) {
+#if INK_SLOTS > 0
+        for (int i = 0; i < INK_SLOTS; ++i) {
             vec3 miss = abs(pure_encoded - inks[i]);
             seen = seen || max(max(miss.r, miss.g), miss.b) <= INK_TOLERANCE;
         }
+#endif
         if (!seen || !(reach > SHORT_REACH)) return result;
     }
 #if PURE_GATE
