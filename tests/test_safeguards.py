@@ -30,6 +30,54 @@ def test_blend_space_is_the_space_of_the_antialiasing(shapes, space):
     assert chosen == space, residuals
 
 
+def _map(space, quality=None, family="maps"):
+    """The real-tools suite's map, antialiased in `space`, 8-bit (through a JPEG at `quality`)."""
+    import io
+
+    from PIL import Image
+
+    from aarecovery.lab.realtools import FAMILIES, render_family
+    from aarecovery.plan.resample import box_downsample
+    levels = np.rint(box_downsample(render_family(family, 96), FAMILIES[family].k, space) * 255).astype(np.uint8)
+    if quality is not None:
+        buffer = io.BytesIO()
+        Image.fromarray(levels).save(buffer, format="JPEG", quality=quality)
+        levels = np.asarray(Image.open(io.BytesIO(buffer.getvalue())).convert("RGB"))
+    return levels.astype(np.float32) / 255
+
+
+@pytest.mark.parametrize("space", ["linear", "srgb"])
+def test_a_maps_edges_vote_for_its_space_where_three_colours_meet(space):
+    # A map's contour lines over its tints meet in pixels of three colours, which fit no
+    # colour line in either space: the mean residuals tie (the sRGB map 0.024 against 0.025)
+    # and told linear light; its two-colour edges fit only their own space.
+    from aarecovery.plan.blend_space import means_tell_srgb
+    chosen, residuals = choose_blend_space(rgba(_map(space)))
+    assert chosen == space, residuals
+    assert not means_tell_srgb(residuals)
+
+
+def test_a_jpegs_edges_do_not_vote():
+    # Compression noise fits sRGB values better whatever the space (plan.blend_space): the
+    # star burst antialiased in linear light, saved at q 75, would vote for sRGB values.
+    original = _map("linear", quality=75, family="starburst")
+    assert choose_blend_space(rgba(original))[0] == "srgb"
+    assert choose_blend_space(rgba(original), lossless=False)[0] == "linear"
+    assert analyse(rgba(original), rgba(original ** 2)).blend_space == "linear"
+
+
+def test_f_affine_in_linear_light_is_kept_where_the_edges_voted_for_srgb():
+    # The sRGB map's grey by luminance in linear light (G'MIC's -luminance) is 53 dB from
+    # the reference: where the means tie, an affine map in either space is F already right.
+    from aarecovery.colour import LUMA, linear_to_srgb, srgb_to_linear
+    original = _map("srgb")
+    grey = linear_to_srgb(srgb_to_linear(original) @ np.array(LUMA, np.float32))
+    filtered = np.repeat(np.rint(grey * 255)[..., None] / 255, 3, axis=-1).astype(np.float32)
+    plan = analyse(rgba(original), rgba(filtered))
+    assert plan.blend_space == "srgb"
+    assert plan.decision == Decision.AFFINE_KEPT and "in linear values" in plan.reason
+
+
 def test_blur_is_detected_and_left_alone(shapes):
     case = make_case(shapes, "blur", 4, "srgb")
     assert fit_lowpass(case.original, case.filtered)[0]

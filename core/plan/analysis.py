@@ -76,7 +76,7 @@ from ..contract import layout_of, to_rgba_float
 from ..params import ITERATIONS, SIGMA_D, SIGMA_E
 from ..spec.local_plan import FLAT_SPAN, LocalStrength
 from ..spec.sobel import gradient_magnitude
-from .blend_space import choose_blend_space
+from .blend_space import choose_blend_space, means_tell_srgb
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
 from .compression import (COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SHARPENED_BLEND_SPACE, COMPRESSED_SHARPENED_STRENGTH,
@@ -267,10 +267,11 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     """
     o_rgba = analysis_crop(original_rgba)
     f_rgba = analysis_crop(filtered_rgba)
-    space, residuals = choose_blend_space(o_rgba, linear_input)
     # The remaining analysis is on sRGB-encoded colour, as filters see it.
     o = o_rgba[..., :3] if not linear_input else linear_to_srgb(o_rgba[..., :3])
     f = f_rgba[..., :3] if not linear_input else linear_to_srgb(f_rgba[..., :3])
+    compression = compression_evidence(o, quantization)
+    space, residuals = choose_blend_space(o_rgba, linear_input, lossless=not compression.compressed)
     fit = residuals[space]
     lowpass, kernel_residual, _ = fit_lowpass(o, f)
     if lowpass:
@@ -291,6 +292,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # strip -0.03 to -0.08, hatching -0.03 to -0.18 in linear light): the manga's own dots, not
     # screentone as such. The held-out half has no grey screentone to tell.
     affine_spaces = (space, "srgb") if space == "linear" and grey else (space,)
+    if space == "srgb" and not means_tell_srgb(residuals):
+        affine_spaces = (space, "linear")  # the edge pixels voted (blend_space.means_tell_srgb)
     for affine_space in affine_spaces:
         affine = affine_share(o, f, edges, affine_space)
         if affine >= AFFINE_SHARE:
@@ -298,7 +301,6 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                             "edges, so its edges are already right: kept F", Decision.AFFINE_KEPT,
                                 forcing=forcing_advice(Decision.AFFINE_KEPT))
     transfer = fit_pointwise(o, f, edges)
-    compression = compression_evidence(o, quantization)
     textured, texture = is_textured(o, fit, compression)
     # A comic's screentone reads as texture, but it is a drawing (plan/hatching.py): under a
     # point-wise filter it takes the hard-edged branch below, as under a neighbourhood filter.
