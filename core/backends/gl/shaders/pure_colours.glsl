@@ -7,9 +7,9 @@ uniform vec3 palette[32];          // O's flat colours, opaque, in the working s
 uniform int palette_size;
 // INK_SLOTS: the seen-ink test's length, compiled in: the fewest of _INK_SLOT_COUNTS
 // (backends/gl/backend.py) that hold O's inks, the slots past them holding a colour that no
-// encoded colour comes near. A loop whose length is a uniform cost llvmpipe a quarter of the fit on the
-// thin-features pair at 4096^2 (1.43-1.79 -> 1.15-1.50 s, alternating runs), where a loop of
-// 16 slots with a uniform guard cost as much as that uniform loop.
+// encoded colour comes near. On llvmpipe a loop whose length is a uniform cost far more than
+// its arithmetic, and a loop over all 16 slots with a uniform guard as much again
+// (docs/performance.md, "The seen-ink test's length compiled in").
 #ifndef INK_SLOTS
 #define INK_SLOTS 0
 #endif
