@@ -18,7 +18,8 @@ from ..spec.pure_colours import (EXTENSION_KEYS, INK_COUNT, INK_TOLERANCE, PALET
 from .pointwise import POINTWISE_SHARE, TABLE_KEYS, filled_bins, key_of
 
 __all__ = ["palette_of", "inks_of", "is_monotone", "turns_at_most_once", "ONE_TURN_VARIATION", "extrapolate_table",
-           "pure_colour_prior", "affine_in_key_miss", "STRAIGHT_TABLE_MISS", "COMPRESSED_LUMA_PURITY"]
+           "pure_colour_prior", "affine_in_key_miss", "clipped_share", "STRAIGHT_TABLE_MISS",
+           "STRAIGHT_TABLE_CLIPPED", "COMPRESSED_LUMA_PURITY"]
 
 # A flat pixel's 3x3 neighbourhood lies within this of its colour (encoded values), and a
 # palette colour needs this many flat pixels.
@@ -208,6 +209,17 @@ def extrapolate_table(table, filled):
 #: tuning half, tables of one value per pixel: thresholds miss by 7.8/255 (maps) to 57/255;
 #: G'MIC's -luminance 0-0.7/255 and GEGL's hue-chroma on the star burst 2.5-3.5/255.
 STRAIGHT_TABLE_MISS = 4.0 / 255
+#: ... unless F clips on more than this share of O's edge pixels: an affine map of the key that
+#: saturates inside O's range (an autocontrast, a levels stretch) bends there as a threshold
+#: does, and its ink past O's darkest extreme is the saturated colour. Measured on the
+#: real-tools tuning half (edge pixels whose F is 0 or 1 in a channel where the affine fit of
+#: the unsaturated ones passes the range by over 4/255): Pillow's autocontrast on the memo,
+#: the notice and the star burst 0.022-0.029, on the icons and the screenshot 0.000-0.002;
+#: G'MIC's -luminance and GEGL's hue-chroma 0.000 on every drawing.
+STRAIGHT_TABLE_CLIPPED = 0.01
+# F saturates in a channel within half an 8-bit step of 0 or 1; the affine fit passes the
+# range when it lies beyond it by more than the straight miss.
+_SATURATED = 0.5 / 255
 
 
 def affine_in_key_miss(original, filtered, edges, key):
@@ -229,15 +241,45 @@ def affine_in_key_miss(original, filtered, edges, key):
     """
     if key not in TABLE_KEYS or not edges.any():
         return float("inf")
+    misses = []
+    for design, target in _affine_designs(original, filtered, edges, key):
+        coefficients, *_ = np.linalg.lstsq(design, target, rcond=None)
+        misses.append(np.abs(design @ coefficients - target))
+    return float(largest_channel(np.stack(misses, axis=-1)).mean())
+
+
+def _affine_designs(original, filtered, edges, key):
+    """Per channel, the design matrix of an affine function of the key on the edge pixels
+    (key, 1), float64, and F's channel there."""
     values = key_of(original, key)[edges].astype(np.float64)
     target = filtered[edges].astype(np.float64)
-    miss = np.zeros(target.shape)
     for c in range(3):
         x = values[:, c] if key == "channel" else values
-        design = np.stack([x, np.ones_like(x)], axis=1)
-        coefficients, *_ = np.linalg.lstsq(design, target[:, c], rcond=None)
-        miss[:, c] = np.abs(design @ coefficients - target[:, c])
-    return float(largest_channel(miss).mean())
+        yield np.stack([x, np.ones_like(x)], axis=1), target[:, c]
+
+
+def clipped_share(original, filtered, edges, key):
+    """Share of O's edge pixels where F is an affine function of the table's key, clipped.
+
+    Per channel, the affine fit of F on the key over the edge pixels where F is not saturated;
+    a pixel counts where F is 0 (or 1) in a channel and that fit lies below 0 (above 1) by more
+    than :data:`STRAIGHT_TABLE_MISS` there.
+
+    The parameters are :func:`affine_in_key_miss`'s. Returns a float in [0, 1]; 0 for scale
+    keys or no edges.
+    """
+    if key not in TABLE_KEYS or not edges.any():
+        return 0.0
+    clipped = np.zeros(int(edges.sum()), bool)
+    for design, target in _affine_designs(original, filtered, edges, key):
+        low, high = target <= _SATURATED, target >= 1 - _SATURATED
+        middle = ~low & ~high
+        if middle.sum() < 2:
+            continue
+        coefficients, *_ = np.linalg.lstsq(design[middle], target[middle], rcond=None)
+        fitted = design @ coefficients
+        clipped |= (low & (fitted < -STRAIGHT_TABLE_MISS)) | (high & (fitted > 1 + STRAIGHT_TABLE_MISS))
+    return float(clipped.mean())
 
 
 def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None, noise_contrast=0.0,
@@ -309,12 +351,16 @@ def pure_colour_prior(original, transfer, blend_space, filtered=None, edges=None
     chosen = priors[0]
     if not _agree_where_extended(priors, original, blend_space):
         chosen = dataclasses.replace(chosen, to_cube=False)
-    elif filtered is not None and affine_in_key_miss(original, filtered, edges, chosen.key) < STRAIGHT_TABLE_MISS:
+    elif (filtered is not None and affine_in_key_miss(original, filtered, edges, chosen.key) < STRAIGHT_TABLE_MISS
+          and clipped_share(original, filtered, edges, chosen.key) <= STRAIGHT_TABLE_CLIPPED):
         # The extension guesses an ink O never shows and reads the table's extrapolation
-        # there: worth it where the table bends (a threshold, levels), only its own error
-        # where F is a straight function of the key (colour to grey, a hue change of a few
-        # colours). Tuning half: the sRGB star burst under G'MIC's -luminance -1.94 with
-        # the extension, +0.42 without; under GEGL's hue-chroma -0.21 / +0.52.
+        # there: worth it where the table bends (a threshold, levels, an affine stretch that
+        # clips), only its own error where F is a straight function of the key (colour to
+        # grey, a hue change of a few colours). Tuning half: the sRGB star burst under G'MIC's
+        # -luminance -1.94 with the extension, +0.42 without; under GEGL's hue-chroma -0.21 /
+        # +0.52. Pillow's autocontrast (2% clipped at each end) was read as straight: its
+        # sub-pixel strokes kept O's darkest extreme as their ink (the memo 0.214, the notice
+        # 0.113 of their edge error; 0.681 and 0.672 extended).
         chosen = dataclasses.replace(chosen, to_cube=False)
     return chosen
 
