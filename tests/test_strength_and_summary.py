@@ -187,6 +187,14 @@ def test_a_smoothed_photo_says_what_forcing_risks():
     assert "risks flattening the photo's texture" in summary.line(force="--strength 1")
 
 
+def test_the_advice_holds_where_f_was_exact_at_half_resolution():
+    # The calibration's error at strength 0 can be exactly 0 (a table that commutes with the
+    # box filter on the edges it read); the advice divided by it.
+    forcing = forcing_advice(Decision.POINTWISE_HARD_EDGED_GRAINED, errors={0.0: 0.0, 0.25: 1e-6, 0.5: 4e-6,
+                                                                          1.0: 1e-5, 0.125: 2e-7})
+    assert not forcing.helps and "F was exact" in forcing.why
+
+
 def test_a_repair_within_the_models_error_says_so():
     forcing = forcing_advice(Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT, ratio=1.19)
     assert not forcing.helps and "repair-to-error ratio 1.19" in forcing.why

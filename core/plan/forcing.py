@@ -57,6 +57,11 @@ def forcing_advice(decision, ratio=None, errors=None):
             gain = 1 - errors[best] / errors[0.0]
             return Forcing(True, f"at half resolution strength {best:g} was {gain:.1%} closer than F, "
                                  "too little to choose it")
+        if errors[0.0] == 0:
+            # F already reproduced the half-resolution truth exactly (a filter that commutes
+            # with the box filter on these edges): there is no relative loss to quote.
+            return Forcing(False, "a result farther from the truth than F: at half resolution F was exact and "
+                                  "every strength tried moved it away")
         return Forcing(False, "a result farther from the truth than F: at half resolution every strength tried "
                               f"was worse than F (strength 1 by {errors[1.0] / errors[0.0] - 1:.0%})")
     if ratio is not None:
