@@ -226,3 +226,28 @@ def test_a_grained_page_under_a_filter_that_keeps_its_paper_gets_pure_colours(fi
     # Measured: bilateral 0.76 (0.70 without the prior), unsharp 0.78 (0.66); before the
     # paper's mean was read, both kept the paper's passes (no prior).
     assert with_prior > without + 0.03, (with_prior, without)
+
+
+def test_no_grain_reaches_fs_flat_paper_under_a_smoothing_filter(backend):
+    """OpenCV's edge-preserving smoothing flattens the memo's light grain (3.7 levels), and keeps
+    the paper's mean, so the letters get pure colours; a dip of the grain beside a letter took
+    the ink's colour on F's flat paper (18 pixels darker than F by over 2 levels of luma)
+    until a thin feature had to stand out from the grain there too."""
+    import dataclasses
+
+    from aarecovery.lab import realtools
+    from aarecovery.lab.metrics import flat_areas, haze_pixels
+    suite = realtools.RealToolsSuite("grain", ("memo",), ("cv-smoothing",), 96, {"memo": ("linear",)})
+    (case,) = realtools.build_cases(suite, "tune", jpeg=False)
+    flat_paper = case.paper & flat_areas(case.filtered)
+    assert flat_paper.sum() > 500
+    with aarecovery.Engine(backend) as engine:
+        engine.set_images(case.original, case.filtered)
+        plan = engine.plan()
+        prior = plan.pure_colours
+        assert prior is not None and "the paper's mean kept" in plan.reason, plan.reason
+        assert prior.noise_contrast == paper_grain(case.original[..., :3]).contrast > 0
+        engine.run(plan)
+        assert haze_pixels(engine.result(), case.filtered, flat_paper) == 0
+        engine.run(dataclasses.replace(plan, pure_colours=dataclasses.replace(prior, noise_contrast=0.0)))
+        assert haze_pixels(engine.result(), case.filtered, flat_paper) > 5
