@@ -337,8 +337,11 @@ def test_a_jpegs_smeared_chroma_is_no_thin_feature(monkeypatch):
     # The star burst at q 98 under a levels curve: between its dark-blue spokes the tan paper
     # keeps its luma, but the JPEG's subsampled chroma gives it the spokes' blue; taken for a
     # thin feature's partial colour, it was extended to a pink that F never had (measured:
-    # -0.151 of the edge error; with the luma purity +0.150).
+    # -0.151 of the edge error; with the luma purity +0.150). Measured where the repair blends
+    # in linear light, where O's colour lines put the pair: blended in sRGB values
+    # (COMPRESSED_HARD_EDGED_BLEND_SPACE), the extension does not reach that pink (+0.125).
     from aarecovery.plan import analysis
+    monkeypatch.setattr(analysis, "COMPRESSED_HARD_EDGED_BLEND_SPACE", "linear")
     case = _curve_case("starburst", "srgb", 98, _LEVELS)
     with_luma, plan = _reduction(*case)
     assert plan.pure_colours is not None and plan.pure_colours.luma_purity > 0, plan.reason
@@ -385,3 +388,34 @@ def test_the_tables_are_read_without_pillow(tmp_path):
               f"print(len(aarecovery.read_quantization({str(tmp_path / 'o.jpg')!r})))")
     run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
     assert run.returncode == 0 and run.stdout.strip() == "2", run.stderr
+
+
+def test_a_jpeg_drawing_under_a_point_wise_filter_blends_in_srgb_values(backend):
+    """A JPEG's quantized DCT and 4:2:0 chroma average the encoded values across an edge, so
+    the edge pixels of a JPEG drawing are blends of encoded colour whatever space the drawing
+    was antialiased in. Serif text antialiased in linear light, saved at q 90, under a
+    threshold (measured, NumPy: 0.548 of the edge error blended in sRGB values, 0.430 in
+    linear light, where its colour lines had put it)."""
+    import dataclasses
+
+    from test_safeguards import family_as_jpeg
+
+    from aarecovery.lab.metrics import edge_band, error_reduction
+    from aarecovery.lab.realtools import FAMILIES
+    from aarecovery.plan.resample import box_downsample
+    scene, clean, original = family_as_jpeg("serif", 96, 90, space="linear")
+    table = np.where(np.arange(256) >= 128, 255, 0).astype(np.uint8)
+    filtered = table[original]
+    reference = box_downsample(table[scene].astype(np.float32) / 255, FAMILIES["serif"].k, "linear")
+    band = edge_band(clean.astype(np.float32) / 255, table[clean].astype(np.float32) / 255, reference)
+    reductions = {}
+    with aarecovery.Engine(backend) as engine:
+        engine.set_images(original, filtered)
+        plan = engine.plan()
+        assert plan.decision == aarecovery.Decision.POINTWISE_HARD_EDGED_COMPRESSED, plan.reason
+        assert plan.blend_space == "srgb"
+        for space in ("srgb", "linear"):
+            engine.run(dataclasses.replace(plan, blend_space=space))
+            reductions[space] = error_reduction(engine.result().astype(np.float32) / 255,
+                                                filtered.astype(np.float32) / 255, reference, band)
+    assert reductions["srgb"] > reductions["linear"] + 0.05, reductions

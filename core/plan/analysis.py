@@ -79,8 +79,9 @@ from ..spec.sobel import gradient_magnitude
 from .blend_space import choose_blend_space, means_tell_srgb
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
-from .compression import (COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SHARPENED_BLEND_SPACE, COMPRESSED_SHARPENED_STRENGTH,
-                          COMPRESSED_SMOOTHED_STRENGTH, GRID_MARGIN, compression_evidence, hidden_compression)
+from .compression import (COMPRESSED_HARD_EDGED_BLEND_SPACE, COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SHARPENED_BLEND_SPACE,
+                          COMPRESSED_SHARPENED_STRENGTH, COMPRESSED_SMOOTHED_STRENGTH, GRID_MARGIN, compression_evidence,
+                          hidden_compression)
 from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
 from .hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screentone_drawing
@@ -372,7 +373,11 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                 decision, above = Decision.POINTWISE_HARD_EDGED_COMPRESSED, compression.describe()
             else:
                 decision, above = Decision.POINTWISE_HARD_EDGED_GRAINED, grain.describe()
-            return PairAnalysis(space, strength,
+            # The repair blends a colour JPEG's edge pixels in sRGB values; the calibration and
+            # the prior read O's colour lines in their own space (COMPRESSED_HARD_EDGED_BLEND_SPACE).
+            in_srgb = compression.compressed and not linear_input and not grey
+            repair_space = COMPRESSED_HARD_EDGED_BLEND_SPACE if in_srgb else space
+            return PairAnalysis(repair_space, strength,
                                 f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges match) "
                                 f"on hard-edged content{thin} above {above}; half-resolution "
                                 f"calibration chose strength {strength:g}", decision, prior,
