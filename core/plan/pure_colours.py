@@ -386,9 +386,69 @@ def _extrapolated(original, candidate, extend_ends):
     # exposure.
     # A shift key's table is not extrapolated: an offset's power law is no curve's, and the
     # curves it fits (equalizations) reach black and white within O's range.
-    table, low, high = extrapolate_table(candidate.table, filled_bins(original, candidate.key))
+    own = filled_bins(original, candidate.key)
+    table, filled = candidate.table, own
+    if candidate.key == "channel":
+        table, filled = shared_channel_table(table, own)
+    extrapolated, _, _ = extrapolate_table(table, filled)
+    # The range stays O's own: its ends say which extremes are O's darkest and brightest colours.
+    _, low, high = extrapolate_table(candidate.table, own)
     extend = extend_ends and candidate.key not in SHIFT_KEYS
-    return {"table": table if extend else candidate.table, "key_low": low, "key_high": high}
+    return {"table": extrapolated if extend else table, "key_low": low, "key_high": high}
+
+
+#: Per-channel tables agree where both channels hold pixels within this (encoded), over at
+#: least :data:`_SHARED_OVERLAP` bins, when they are one curve (:func:`shared_channel_table`).
+SHARED_CHANNEL_AGREEMENT = 4.0 / 255
+_SHARED_OVERLAP = 8
+
+
+def shared_channel_table(table, filled):
+    """Fill a per-channel table's clipped end from a channel that is the same curve.
+
+    Most point-wise tools apply one curve to R, G and B, but O's channels cover different
+    ranges: a dark grey ink never seen whole leaves the green and blue columns empty below
+    its thin strokes' level, where the curve is clipped at 1 and a flat end says nothing of
+    where it turns (G'MIC's ``-pow 3``: a step at 6 levels), while a green ink's red channel
+    shows the curve down to 0. Beyond a column's last bin with pixels, where its table is
+    clipped there (within :data:`_SATURATED` of 0 or 1), it takes the values of another column
+    that holds pixels there and agrees with it, within :data:`SHARED_CHANNEL_AGREEMENT`, on
+    every bin both hold (at least :data:`_SHARED_OVERLAP`).
+
+    Parameters
+    ----------
+    table : ndarray of float32, shape (256, 3)
+        The fitted table, interpolated across its empty bins (``aarecovery.plan.pointwise``).
+    filled : ndarray of bool, shape (256, 3)
+        Bins that held pixels, per column.
+
+    Returns
+    -------
+    table : ndarray of float32, shape (256, 3)
+    filled : ndarray of bool, shape (256, 3)
+        The bins that hold a pixel of the column or of the column it took values from.
+    """
+    shared, held = table.copy(), filled.copy()
+    bins = np.arange(len(table))
+    for c in range(3):
+        own = np.nonzero(filled[:, c])[0]
+        if not len(own):
+            continue
+        for end, beyond in ((own[0], bins < own[0]), (own[-1], bins > own[-1])):
+            value = table[end, c]
+            if not (value <= _SATURATED or value >= 1 - _SATURATED):
+                continue
+            for d in range(3):
+                both = filled[:, c] & filled[:, d]
+                new = filled[:, d] & beyond & ~held[:, c]
+                if d == c or both.sum() < _SHARED_OVERLAP or not new.any():
+                    continue
+                if np.abs(table[both, c] - table[both, d]).max() <= SHARED_CHANNEL_AGREEMENT:
+                    shared[new, c], held[new, c] = table[new, d], True
+        if not np.array_equal(held[:, c], filled[:, c]):
+            kept = np.nonzero(held[:, c])[0]
+            shared[:, c] = np.interp(bins, kept, shared[kept, c])
+    return shared.astype(np.float32), held
 
 
 # Tables that explain F within this mean miss of the best one tie with it.
