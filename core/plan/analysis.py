@@ -80,6 +80,7 @@ from .blend_space import choose_blend_space, means_tell_srgb
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
 from .compression import (COMPRESSED_HARD_EDGED_BLEND_SPACE, COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SHARPENED_BLEND_SPACE,
+                          COMPRESSED_SMOOTHED_BLEND_SPACE,
                           COMPRESSED_SHARPENED_STRENGTH, COMPRESSED_SMOOTHED_STRENGTH, GRID_MARGIN, compression_evidence,
                           hidden_compression)
 from .flat_colours import flat_colour_prior
@@ -601,7 +602,9 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # A JPEG's noise goes through a smoothing filter too, spread over the edges: the repair
     # at a lower strength, without pure colours (see COMPRESSED_SMOOTHED_STRENGTH).
     if smoothing and compression.compressed:
-        return PairAnalysis(space, COMPRESSED_SMOOTHED_STRENGTH,
+        # ... blended in sRGB values on colour (COMPRESSED_SMOOTHED_BLEND_SPACE).
+        smoothed_space = COMPRESSED_SMOOTHED_BLEND_SPACE if not linear_input and not grey else space
+        return PairAnalysis(smoothed_space, COMPRESSED_SMOOTHED_STRENGTH,
                             why + f": a smoothing filter above {compression.describe()}, strength "
                                   f"{COMPRESSED_SMOOTHED_STRENGTH:g}" + _UNTOUCHED, Decision.NEIGHBOURHOOD_HARD_EDGED,
                             **untouched)
