@@ -8,6 +8,7 @@ from aarecovery.lab import scenes as _scenes
 from aarecovery.lab.groundtruth import make_case
 from aarecovery.lab.metrics import edge_band, error_reduction
 from aarecovery.plan.pure_colours import inks_of, is_monotone, palette_of, turns_at_most_once
+from aarecovery.spec.pure_colours import INK_COUNT
 from aarecovery.tiling import halo_for
 from aarecovery.spec import fit_blend_model, to_working_space
 from aarecovery.plan import analyse
@@ -39,8 +40,17 @@ def test_inks_are_colours_on_the_cubes_faces_seen_four_times_or_more():
     image[2, :3] = (1, 0, 0)                          # 3 times: too few
     image[3, :7] = (3 / 255, 100 / 255, 100 / 255)    # 7 times, 3 levels from a face
     inks = inks_of(image)
-    np.testing.assert_array_equal(inks * 255, [[253, 200, 10], [0, 89, 38]])  # most frequent first
+    # Most frequent first, then black and white, which O does not show (CORNER_INKS).
+    np.testing.assert_array_equal(inks * 255, [[253, 200, 10], [0, 89, 38], [0, 0, 0], [255, 255, 255]])
     assert inks.dtype == np.float32
+    image[4] = 1                                      # white seen: not twice
+    np.testing.assert_array_equal(inks_of(image) * 255, [[255, 255, 255], [253, 200, 10], [0, 89, 38], [0, 0, 0]])
+    many = np.zeros((4, 20 * 4, 3), np.float32)       # 20 saturated inks seen: the corners take the last places
+    many[..., 0] = 1
+    many[..., 1] = np.repeat(np.arange(20) * 10 + 5, 4)[None] / 255
+    inks = inks_of(many)
+    assert len(inks) == INK_COUNT
+    np.testing.assert_array_equal(inks[-2:], [[0, 0, 0], [1, 1, 1]])
 
 
 def test_thin_strokes_erased_by_threshold_are_restored():
@@ -414,3 +424,27 @@ def test_thin_strokes_of_an_ink_no_channel_shows_whole_take_the_curve_another_ch
     monkeypatch.setattr(plan_pure_colours, "SHARED_CHANNEL_AGREEMENT", -1.0)
     alone = reduction()
     assert shared > alone + 0.3
+
+
+def test_near_whole_pixels_of_black_ink_that_o_never_shows_whole_get_black(backend, monkeypatch):
+    # The manga page saved at q 95 and thresholded: the JPEG leaves no exact black, so no ink
+    # is seen, and a pixel nearly covered by the dark ink lies within MIN_REACH of the cube's
+    # corner: it kept F's colour until black became an ink of every page (CORNER_INKS).
+    # Measured (NumPy): 0.840 of the error with the corners, 0.684 without. The page's ink is
+    # (10, 10, 13), not black: under a steep curve at black (the built-in gamma, x ** 0.5) the
+    # sRGB page at q 95 fell 0.500 -> 0.325 (its linear twin rose 0.510 -> 0.713).
+    from test_jpeg_evidence import _encoded, _jpeg_round_trip
+
+    from aarecovery.filters import apply
+    from aarecovery.lab.realtools import render_family
+    from aarecovery.plan import pure_colours as plan_pure_colours
+    case = make_case(render_family("manga", 96), "threshold", 8, "linear")
+    original = _encoded(_jpeg_round_trip(np.rint(np.clip(case.original, 0, 1) * 255).astype(np.uint8), 95))
+    filtered = np.clip(apply("threshold", original), 0, 1).astype(np.float32)
+
+    def reduction():
+        return error_reduction(aarecovery.recover(original, filtered, backend=backend), filtered, case.reference, None)
+
+    with_corners = reduction()
+    monkeypatch.setattr(plan_pure_colours, "CORNER_INKS", ())
+    assert with_corners > reduction() + 0.1

@@ -125,12 +125,24 @@ def inks_of(original):
     Black, white and saturated inks are seen whole in strokes too thin to leave a flat pixel;
     their partial colours' extensions to the cube land on them. `original` as for
     :func:`palette_of`; the result too, with N <= ``INK_COUNT`` colours seen at least 4 times
-    (flat or not) that have a channel within ``INK_TOLERANCE`` of 0 or 1.
+    (flat or not) that have a channel within ``INK_TOLERANCE`` of 0 or 1, then black and white
+    where O does not show them (:data:`CORNER_INKS`).
     """
     levels = np.rint(np.clip(original.reshape(-1, 3), 0, 1) * 255).astype(np.int32)
     reach = int(round(INK_TOLERANCE * 255))
     on_face = ((levels <= reach) | (levels >= 255 - reach)).any(axis=1)
-    return _most_frequent(levels[on_face], INK_COUNT)
+    seen = _most_frequent(levels[on_face], INK_COUNT)
+    unseen = [ink for ink in np.asarray(CORNER_INKS, np.float32) if not (seen == ink).all(axis=1).any()]
+    if not unseen:
+        return seen
+    return np.concatenate([seen[:INK_COUNT - len(unseen)], np.stack(unseen)]).astype(np.float32)
+
+
+#: Inks of every page, seen or not: black and white. A thin stroke of black ink whose whole
+#: pixel O never shows (serif's smallest text; the manga's JPEG twins, whose noise leaves no
+#: exact black) has near-whole pixels within MIN_REACH of the cube's corner, which kept F's
+#: colour there.
+CORNER_INKS = ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
 
 
 def _flat(original):
