@@ -430,9 +430,8 @@ def test_near_whole_pixels_of_black_ink_that_o_never_shows_whole_get_black(backe
     # The manga page saved at q 95 and thresholded: the JPEG leaves no exact black, so no ink
     # is seen, and a pixel nearly covered by the dark ink lies within MIN_REACH of the cube's
     # corner: it kept F's colour until black became an ink of every page (CORNER_INKS).
-    # Measured (NumPy): 0.840 of the error with the corners, 0.684 without. The page's ink is
-    # (10, 10, 13), not black: under a steep curve at black (the built-in gamma, x ** 0.5) the
-    # sRGB page at q 95 fell 0.500 -> 0.325 (its linear twin rose 0.510 -> 0.713).
+    # Measured (NumPy), with the dark ink left out of the palette (the next test): 0.840 of
+    # the error with the corners, 0.684 without.
     from test_jpeg_evidence import _encoded, _jpeg_round_trip
 
     from aarecovery.filters import apply
@@ -445,6 +444,32 @@ def test_near_whole_pixels_of_black_ink_that_o_never_shows_whole_get_black(backe
     def reduction():
         return error_reduction(aarecovery.recover(original, filtered, backend=backend), filtered, case.reference, None)
 
+    monkeypatch.setattr(plan_pure_colours, "_DARK_INK_COUNT", 10 ** 9)
     with_corners = reduction()
     monkeypatch.setattr(plan_pure_colours, "CORNER_INKS", ())
     assert with_corners > reduction() + 0.1
+
+
+def test_a_dark_ink_that_leaves_no_flat_pixel_stops_the_extension_short_of_black(backend, monkeypatch):
+    # The manga page's ink is (10, 10, 13); saved at q 95 it leaves no flat pixel, and its
+    # near-whole pixels were extended to black (CORNER_INKS), which the built-in gamma
+    # (x ** 0.5, steep at black) maps 50 levels from the ink's colour. The median of O's
+    # pixels within 24 levels of black is a palette colour (DARK_INK_REACH) and stops the
+    # extension there. Measured (NumPy): sRGB page 0.492 of the error against 0.325 without.
+    from test_jpeg_evidence import _encoded, _jpeg_round_trip
+
+    from aarecovery.filters import apply
+    from aarecovery.lab.realtools import render_family
+    from aarecovery.plan import pure_colours as plan_pure_colours
+    case = make_case(render_family("manga", 96), "gamma", 8, "srgb")
+    original = _encoded(_jpeg_round_trip(np.rint(np.clip(case.original, 0, 1) * 255).astype(np.uint8), 95))
+    filtered = np.clip(apply("gamma", original), 0, 1).astype(np.float32)
+    ink = plan_pure_colours.palette_of(original)[-1] * 255
+    assert np.abs(ink - [10, 10, 13]).max() <= 3, ink
+
+    def reduction():
+        return error_reduction(aarecovery.recover(original, filtered, backend=backend), filtered, case.reference, None)
+
+    with_dark_ink = reduction()
+    monkeypatch.setattr(plan_pure_colours, "_DARK_INK_COUNT", 10 ** 9)
+    assert with_dark_ink > reduction() + 0.1
