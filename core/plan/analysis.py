@@ -80,9 +80,8 @@ from .blend_space import choose_blend_space, means_tell_srgb
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
 from .compression import (COMPRESSED_HARD_EDGED_BLEND_SPACE, COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SHARPENED_BLEND_SPACE,
-                          COMPRESSED_SMOOTHED_BLEND_SPACE,
-                          COMPRESSED_SHARPENED_STRENGTH, COMPRESSED_SMOOTHED_STRENGTH, GRID_MARGIN, compression_evidence,
-                          hidden_compression)
+                          COMPRESSED_SHARPENED_STRENGTH, COMPRESSED_SMOOTHED_BLEND_SPACE, COMPRESSED_SMOOTHED_STRENGTH,
+                          GRID_MARGIN, compression_evidence, hidden_compression)
 from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
 from .hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screentone_drawing

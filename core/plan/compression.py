@@ -96,10 +96,11 @@ COMPRESSED_REPAIR_TO_ERROR = 10.0
 #: 0.1 dB (serif under OpenCV's smoothing at q 75: 0.91 dB); 0.75: 1 (0.34 dB); 0.5: none.
 COMPRESSED_SMOOTHED_STRENGTH = 0.5
 #: The space a smoothing filter's repair blends in on hard-edged colour content from a JPEG
-#: (not from linear-light input), at :data:`COMPRESSED_SMOOTHED_STRENGTH`, as under point-wise
-#: and sharpening filters: the JPEG averaged the encoded values across the edges. Tuning half,
-#: the three cases this reading takes (serif under OpenCV's smoothing at q 75 and 90, G'MIC's
-#: bilateral at q 98): 0.025 -> 0.076, 0.156 -> 0.225, 0.197 -> 0.255 of the edge error.
+#: (not from linear-light input, not on a grey image), at :data:`COMPRESSED_SMOOTHED_STRENGTH`,
+#: as under point-wise and sharpening filters: the JPEG averaged the encoded values across the
+#: edges. Tuning half, the three cases this reading takes (serif under OpenCV's smoothing at
+#: q 75 and 90, G'MIC's bilateral at q 98): 0.025 -> 0.077, 0.158 -> 0.227, 0.198 -> 0.256 of
+#: the edge error; held out, no case takes it.
 COMPRESSED_SMOOTHED_BLEND_SPACE = "srgb"
 #: The strength under a sharpening filter (an unsharp mask, detail enhancement) on hard-edged
 #: content from a JPEG whose repair-to-error ratio is below :data:`COMPRESSED_REPAIR_TO_ERROR`:

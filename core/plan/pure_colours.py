@@ -14,8 +14,7 @@ from ..colour import largest_channel
 from ..params import SIGMA_D, SIGMA_E
 from ..spec import to_working_space
 from ..spec.pure_colours import (EXTENSION_KEYS, INK_COUNT, INK_TOLERANCE, PALETTE_SIZE, PALETTE_TOLERANCE, SCALE_KEYS,
-                                 SHIFT_KEYS,
-                                 PureColourPrior, filtered_colour, fit_pure_colour_model)
+                                 SHIFT_KEYS, PureColourPrior, filtered_colour, fit_pure_colour_model)
 from .pointwise import POINTWISE_SHARE, TABLE_KEYS, filled_bins, key_of
 
 __all__ = ["palette_of", "inks_of", "is_monotone", "turns_at_most_once", "ONE_TURN_VARIATION", "extrapolate_table",
@@ -426,12 +425,13 @@ def _extrapolated(original, candidate, extend_ends):
     # A shift key's table is not extrapolated: an offset's power law is no curve's, and the
     # curves it fits (equalizations) reach black and white within O's range.
     own = filled_bins(original, candidate.key)
-    table, filled = candidate.table, own
+    # The range stays O's own: its ends say which extremes are O's darkest and brightest colours.
+    extrapolated, low, high = extrapolate_table(candidate.table, own)
+    table = candidate.table
     if candidate.key == "channel":
         table, filled = shared_channel_table(table, own)
-    extrapolated, _, _ = extrapolate_table(table, filled)
-    # The range stays O's own: its ends say which extremes are O's darkest and brightest colours.
-    _, low, high = extrapolate_table(candidate.table, own)
+        if not np.array_equal(filled, own):
+            extrapolated, _, _ = extrapolate_table(table, filled)
     extend = extend_ends and candidate.key not in SHIFT_KEYS
     return {"table": extrapolated if extend else table, "key_low": low, "key_high": high}
 
