@@ -25,6 +25,7 @@ TWINS = {
     ("pure_colours.glsl", "MIN_REACH"): pure_colours.MIN_REACH,
     ("pure_colours.glsl", "INK_TOLERANCE"): pure_colours.INK_TOLERANCE,
     ("pure_colours.glsl", "SHORT_REACH"): pure_colours.SHORT_REACH,
+    ("pure_colours.glsl", "RIDGE_EDGE_SCALE"): pure_colours.RIDGE_EDGE_SCALE,
     ("transfer_table.glsl", "OPENCV_Y"): pure_colours._OPENCV_Y,
     ("transfer_table.glsl", "PILLOW_Y"): pure_colours._PILLOW_Y,
     ("transfer_table.glsl", "REC601_Y"): pure_colours._REC601_Y,

@@ -12,7 +12,7 @@ import numpy as np
 
 from .neighbourhood import dot, neighbours, planes
 
-__all__ = ["sobel_gradients", "sobel_magnitude", "image_gradients", "gradient_magnitude"]
+__all__ = ["sobel_gradients", "sobel_magnitude", "ridge_magnitude", "image_gradients", "gradient_magnitude"]
 
 
 def sobel_gradients(around):
@@ -51,6 +51,35 @@ def sobel_magnitude(around):
     """
     gx, gy = sobel_gradients(around)
     return np.sqrt(dot(gx, gx) + dot(gy, gy))
+
+
+def ridge_magnitude(around):
+    """How far the centre of a 4-channel neighbourhood stands out from its opposite neighbours.
+
+    A 1 px line or dot centred on the pixel (a screentone's grid of dots, a stroke on the
+    pixel grid) has no Sobel gradient there: its neighbours are symmetric about it. This is
+    the largest, over the four opposite pairs (N/S, W/E, NW/SE, NE/SW), of the distance from
+    the centre to the pair's mean, Euclidean over the channels: a unit line gives 1, a unit
+    step 1/2 beside it, a ramp 0.
+
+    Parameters
+    ----------
+    around : list of 9 ndarray, shape (4, ...)
+        In ``NEIGHBOUR_OFFSETS`` order.
+
+    Returns
+    -------
+    ndarray, shape (...)
+    """
+    v = around
+    half = np.float32(0.5)
+    largest = None
+    for i, j in ((1, 4), (2, 3), (5, 8), (6, 7)):
+        # Differences first, as for the gradient: a flat neighbourhood gives exactly 0.
+        offset = ((v[0] - v[i]) + (v[0] - v[j])) * half
+        squared = dot(offset, offset)
+        largest = squared if largest is None else np.maximum(largest, squared)
+    return np.sqrt(largest)
 
 
 def image_gradients(image):

@@ -83,8 +83,14 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
 #if PURE_COLOURS
     // With pure colours, a thin feature that the filter erased leaves F flat where it must
     // be restored: only a flat O means there is nothing to fit (see fit_pure_colour_model).
+    // A thin feature centred on p has no Sobel gradient: its ridge magnitude stands in.
+#if PURE_GATE
+    float gate = texelFetch(strength_factor, p, 0).g;  // the regions' weight (local_plan.glsl)
+#else
+    float gate = 1.0;
+#endif
     for (int i = 0; i < 9; ++i) c[i] = original_neighbour(p, i, size);
-    float original_gradient = sobel_magnitude(c);
+    float original_gradient = max(sobel_magnitude(c), ridge_magnitude(c) * RIDGE_EDGE_SCALE * gate);
     edge = original_gradient * filtered_gradient;
     if (original_gradient == 0.0) {
 #else
@@ -142,11 +148,6 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
     // The extremes' offsets as base-3 digits (x and y of a, then of b); jacobi.glsl decodes them.
     float code = float((offset_a.x + 1) + 3 * (offset_a.y + 1) + 9 * (offset_b.x + 1) + 27 * (offset_b.y + 1));
 #if PURE_COLOURS
-#if PURE_GATE
-    float gate = texelFetch(strength_factor, p, 0).g;  // the regions' weight (local_plan.glsl)
-#else
-    float gate = 1.0;
-#endif
     Extension ext_a = extend_extreme(c_a, c_b, p + offset_a, f_a, size, gate);
     Extension ext_b = extend_extreme(c_b, c_a, p + offset_b, f_b, size, gate);
     if (ext_a.extended || ext_b.extended) {

@@ -59,6 +59,7 @@ const float MIN_CONTRAST = 8.5 / 255.0;
 const float MIN_REACH = 1.2001;
 const float INK_TOLERANCE = 2.0 / 255.0;
 const float SHORT_REACH = 1.0001;
+const float RIDGE_EDGE_SCALE = 0.5;
 
 vec3 encoded_of(vec4 colour) {
     float coverage = colour.a;
