@@ -9,13 +9,16 @@ backends. Borders replicate edge pixels.
 
 import numpy as np
 
-__all__ = ["NEIGHBOUR_OFFSETS", "planes", "neighbours", "dot"]
+__all__ = ["NEIGHBOUR_OFFSETS", "OPPOSITE_PAIRS", "planes", "neighbours", "dot"]
 
 #: (row, column) offsets of the 3x3 neighbourhood in tie-breaking order: centre, N, W, E, S,
 #: then the diagonals NW, NE, SW, SE. On a flat pixel beside an edge every neighbour ties;
 #: preferring the centre, then the nearest neighbours, keeps R from copying a neighbour into
 #: flat pixels (measured: unsharp mask and blur cases improved markedly over row-major order).
 NEIGHBOUR_OFFSETS = ((0, 0), (-1, 0), (0, -1), (0, 1), (1, 0), (-1, -1), (-1, 1), (1, -1), (1, 1))
+#: Indices into :data:`NEIGHBOUR_OFFSETS` of the neighbours opposite each other across the
+#: centre: N/S, W/E, NW/SE, NE/SW.
+OPPOSITE_PAIRS = ((1, 4), (2, 3), (5, 8), (6, 7))
 
 
 def planes(image):

@@ -10,7 +10,7 @@ had broken into bands (measured).
 
 import numpy as np
 
-from .neighbourhood import dot, neighbours, planes
+from .neighbourhood import OPPOSITE_PAIRS, dot, neighbours, planes
 
 __all__ = ["sobel_gradients", "sobel_magnitude", "ridge_magnitude", "image_gradients", "gradient_magnitude"]
 
@@ -59,8 +59,8 @@ def ridge_magnitude(around):
     A 1 px line or dot centred on the pixel (a screentone's grid of dots, a stroke on the
     pixel grid) has no Sobel gradient there: its neighbours are symmetric about it. This is
     the largest, over the four opposite pairs (N/S, W/E, NW/SE, NE/SW), of the distance from
-    the centre to the pair's mean, Euclidean over the channels: a unit line gives 1, a unit
-    step 1/2 beside it, a ramp 0.
+    the centre to the pair's mean, Euclidean over the channels: a line of unit contrast in
+    one channel gives 1, a unit step 1/2 beside it, a ramp 0.
 
     Parameters
     ----------
@@ -74,7 +74,7 @@ def ridge_magnitude(around):
     v = around
     half = np.float32(0.5)
     largest = None
-    for i, j in ((1, 4), (2, 3), (5, 8), (6, 7)):
+    for i, j in OPPOSITE_PAIRS:
         # Differences first, as for the gradient: a flat neighbourhood gives exactly 0.
         offset = ((v[0] - v[i]) + (v[0] - v[j])) * half
         squared = dot(offset, offset)
