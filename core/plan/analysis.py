@@ -368,6 +368,10 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
             # cases) 0.476, times 0.75: 0.417, times 0.5: 0.323; 768 px under the point-wise tools
             # (47 cases) 0.394 -> 0.358 and 0.288 (one case worse than F by over 0.1 dB at the
             # chosen strength, the map under Pillow's YCbCr equalize at q 90, 0.28 dB; none lower).
+            # Nor a higher: the best of 0-1 in quarters was above the chosen strength in 88 of the
+            # tuning half's 120 JPEG cases here, and 1.5 times it (at most 1) moved them 0.526 ->
+            # 0.566 (76 up, 15 down, share of the PNG gain 0.55 -> 0.57), but held out 36 up, 25
+            # down and losses 3 -> 6 (the ink drawing under Pillow's equalize at q 95 0.85 dB).
             strength, errors = calibrate_strength(o, transfer, f, space, sigma_d, sigma_e, iterations)
             if compression.compressed:
                 decision, above = Decision.POINTWISE_HARD_EDGED_COMPRESSED, compression.describe()
@@ -384,6 +388,12 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                                 forcing=forcing_advice(decision, errors=errors) if strength == 0 else None,
                                 edge_scale=grain_edge_scale(grain, o, f, edges, space, sigma_e),
                                 ramp_table=ramp_table_of(transfer, prior) if strength > 0 else None)
+        # Measured and not taken: a strength of ratio / 4 (at least 0.5) where the repair-to-error
+        # ratio (model_error.py) is below 4. Full strength overshoots on the tuning half's sRGB
+        # map under Pillow's autocontrast and OpenCV's gamma (ratios 2.6 and 2.9: 0.300 -> 0.627,
+        # 0.568 -> 0.719; no other of its 183 cases here is below 5), but held out it moved only
+        # colour-to-grey tools, all down (ImageMagick's -colorspace gray on hatching, pies, comic
+        # strip, plots -0.08 to -0.18): their slope along O's colour line is no filter's error.
         return PairAnalysis(space, 1.0, f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges "
                                         f"match) on hard-edged content: full strength{thin}",
                             Decision.POINTWISE_HARD_EDGED, prior)
