@@ -333,8 +333,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # text at 64 px under GEGL's exposure (q 95) lost 5.0 dB: the pure colours of thin features,
     # which the calibration does not see, act across a photo there. Without them the moved
     # cases fell (drawings 0.242 -> 0.194, photos 0.272 -> 0.251). Nor does a grain threshold
-    # scaled to the noise tell the two: at twice the noise's deviation photos read 0.00-0.06
-    # grainy at q 75-90, drawings 0.00-0.30.
+    # scaled to the noise tell the two: at twice the noise's deviation, q 75-90, photos read
+    # 0.00-0.06 grainy and drawings 0.00-0.12 (0.30 at q 95).
     if transfer.consistency >= POINTWISE_SHARE and not textured:
         # Hard-edged content: calibration would be biased here, since O is not a sharp
         # scene at twice the resolution (its edges are already blends) and box2(F) keeps
