@@ -447,3 +447,26 @@ def test_neighbours_equally_far_from_the_mean_start_the_fit_alike(gl_engine):
         actual, maps = aarecovery.recover(original[window], filtered[window], engine=gl_engine, **arguments)
         assert_results_agree(actual, expected, (row, column))
         assert_maps_agree(maps, expected_maps, message=(row, column))
+
+
+@pytest.mark.parametrize("filter_name", ["threshold", "gamma"])
+def test_best_pairs_agree(gl_engine, filter_name):
+    # The safe default's best pair of neighbours where the colour line misses a pixel
+    # (spec.blend_model.best_pair, its GLSL twin in blend_model.glsl): overlapping shapes in
+    # many colours, 8-bit, where the search replaces the line's extremes at junctions.
+    import dataclasses
+
+    from aarecovery.lab import scenes as _scenes
+    from aarecovery.lab.groundtruth import make_case
+    case = make_case(_scenes.render("shapes", 64, 4), filter_name, 4, "srgb")
+    original = np.rint(case.original * 255).astype(np.uint8)
+    filtered = np.rint(case.filtered * 255).astype(np.uint8)
+    actual, maps = aarecovery.recover(original, filtered, engine=gl_engine, return_maps=True)
+    assert gl_engine.last_plan.best_pair
+    expected, expected_maps = aarecovery.recover(original, filtered, backend="numpy", return_maps=True)
+    assert_results_agree(actual, expected)
+    assert_maps_agree(maps, expected_maps, names=("alpha", "beta", "residual"))
+    numpy_engine = aarecovery.Engine(backend="numpy")
+    numpy_engine.set_images(original, filtered)
+    numpy_engine.run(dataclasses.replace(gl_engine.last_plan, best_pair=False))
+    assert np.abs(numpy_engine.result().astype(np.int64) - expected).max() > 8  # the search acted

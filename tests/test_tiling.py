@@ -120,7 +120,7 @@ def _whole_image_specification(original, filtered, plan):
                               blend_space=plan.blend_space)
     work_f = to_working_space(filtered_rgba, blend_space=plan.blend_space)
     recovered, model = recover_working(work_o, work_f, plan.sigma_d, plan.sigma_e, plan.iterations, plan.strength,
-                                       plan.pure_colours, plan.blend_space)
+                                       plan.pure_colours, plan.blend_space, best_pair=plan.best_pair)
     result = from_working_space(recovered, filtered_rgba, blend_space=plan.blend_space, filtered_work=work_f)
     return from_rgba_float(result, f_layout), model
 

@@ -112,6 +112,10 @@ class Plan:
         The ramp lookup's table (``aarecovery.spec.ramp_lookup``): R takes the table averaged
         across each pixel where O is a ramp, as far as the model's confidence leaves it;
         None: no ramp lookup. Only for sRGB-encoded inputs (its delta is in encoded values).
+    best_pair : bool
+        Where the principal colour line misses a pixel, the pair of its neighbours that
+        explains it best gives the model's extremes (``aarecovery.spec.blend_model.best_pair``):
+        the safe default on a lossless O; False, the paper's extremes.
     window : tuple of slice or None
         The rows and columns of the pair that the safe default's analysis read
         (``aarecovery.sample``), when the plan was made from the whole pair: the summary
@@ -133,6 +137,7 @@ class Plan:
     forcing: object = None
     window: tuple = None
     ramp_table: object = None
+    best_pair: bool = False
 
     @property
     def keeps_filtered(self):

@@ -29,7 +29,8 @@ def _recover_in_strips(original, filtered, plan, factor, gate, toward=None):
                                         plan.iterations, plan.strength, plan.pure_colours, plan.blend_space,
                                         None if factor is None else factor[start:stop], plan.untouched_span,
                                         None if gate is None else gate[start:stop],
-                                        toward=None if toward is None else toward[start:stop])
+                                        toward=None if toward is None else toward[start:stop],
+                                        best_pair=plan.best_pair)
         inner = slice(top - start, top - start + bottom - top)
         recovered[top:bottom] = result[inner]
         columns.append([getattr(model, name)[inner] for name in BlendModel.MAP_FIELDS])

@@ -72,5 +72,5 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
                 untouched_span=analysis.untouched_span if asked is None else 0.0,
                 toward_original=analysis.toward_original and asked is None, forcing=analysis.forcing,
                 # The ramp lookup's delta is in sRGB-encoded values, the table's.
-                ramp_table=None if linear else analysis.ramp_table,
+                ramp_table=None if linear else analysis.ramp_table, best_pair=analysis.best_pair,
                 reason=analysis.reason + ("" if asked is None else f"; strength {asked:g} as asked instead"))

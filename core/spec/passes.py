@@ -23,7 +23,7 @@ __all__ = ["to_working_space", "fit_blend_model", "jacobi_step", "from_working_s
 
 
 def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=None, blend_space="linear",
-                    factor=None, untouched_span=0.0, gate=None, toward=None):
+                    factor=None, untouched_span=0.0, gate=None, toward=None, best_pair=False):
     """Fit the two-colour blend model at every pixel of O (section 3.1) and its confidence.
 
     The GL pass of this name also writes the first Jacobi iterate, which it can form from
@@ -58,15 +58,20 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
         A smoothing filter's weight of O's own colour in the Jacobi steps, applied last
         (:func:`~aarecovery.spec.blend_model.toward_original`; the local plan's regions'
         weight); None: none.
+    best_pair : bool
+        Where the principal line misses the centre, the pair of neighbours that explains it
+        best (:func:`~aarecovery.spec.blend_model.best_pair`; ``Plan.best_pair``); False is the
+        paper's model.
 
     Returns
     -------
     BlendModel
     """
     if prior is None:
-        model = fit_paper_model(original, filtered, sigma_d, sigma_e, strength)
+        model = fit_paper_model(original, filtered, sigma_d, sigma_e, strength, best=best_pair)
     else:
-        model = fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, gate)
+        model = fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, gate,
+                                      best=best_pair)
     if factor is not None:
         model.beta = (model.beta * factor).astype(np.float32)
     if untouched_span > 0:
@@ -78,7 +83,8 @@ def fit_blend_model(original, filtered, sigma_d, sigma_e, strength=1.0, prior=No
 
 
 def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1.0, prior=None,
-                    blend_space="linear", factor=None, untouched_span=0.0, gate=None, model=None, toward=None):
+                    blend_space="linear", factor=None, untouched_span=0.0, gate=None, model=None, toward=None,
+                    best_pair=False):
     """Fit the model and run the Jacobi iterations on working-space images.
 
     Parameters are those of :func:`fit_blend_model`, `iterations` (0 returns F) and `model`,
@@ -92,7 +98,7 @@ def recover_working(original, filtered, sigma_d, sigma_e, iterations, strength=1
     """
     if model is None:
         model = fit_blend_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, factor,
-                                untouched_span, gate, toward)
+                                untouched_span, gate, toward, best_pair)
     recovered = filtered
     for _ in range(iterations):
         recovered = jacobi_step(recovered, filtered, model)

@@ -647,7 +647,7 @@ def extend_extreme(far, near, around, filtered_far, on_border, palette, prior, b
 
 
 
-def fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, gate=None):
+def fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior, blend_space, gate=None, best=False):
     """``fit_blend_model`` with the pure colours of thin features (the safe default).
 
     For point-wise filters on hard-edged content (see the module notes for the rule and its
@@ -674,6 +674,9 @@ def fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior,
         partial colour is extended by that share of the way to its pure colour, so that the
         extension fades in with the weight and leaves no seam where the reading changes; at
         0 the model is the paper's (the edge strength too). None: the prior acts everywhere.
+    best : bool
+        Where the principal line misses the centre, a better pair of neighbours
+        (``aarecovery.spec.blend_model.best_pair``), before the extremes are extended.
 
     Returns
     -------
@@ -707,7 +710,7 @@ def fit_pure_colour_model(original, filtered, sigma_d, sigma_e, strength, prior,
     if fitted.any():
         rows, cols = np.nonzero(fitted)
         columns = [colour[:, fitted] for colour in colours]
-        col_alpha, col_residual, col_a, col_b, colour_a, colour_b = fit_extremes(columns, sigma_d)
+        col_alpha, col_residual, col_a, col_b, colour_a, colour_b = fit_extremes(columns, sigma_d, best)
         offsets = np.asarray(NEIGHBOUR_OFFSETS, dtype=np.int64)
         padded_o = np.pad(o_planes, ((0, 0), (2, 2), (2, 2)), mode="edge")
         palette = prior.palette_in(blend_space)

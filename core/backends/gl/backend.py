@@ -426,7 +426,7 @@ class GLBackend:
         if local:
             sources["strength_factor"] = self._work("strength_factor")
         defines = {**self._defines, "PURE_COLOURS": int(prior is not None), "LOCAL_STRENGTH": int(local),
-                   "TOWARD_ORIGINAL": int(plan.toward_original),
+                   "TOWARD_ORIGINAL": int(plan.toward_original), "BEST_PAIR": int(plan.best_pair),
                    "JACOBI_CONSTANT": int(prior is not None or plan.toward_original)}
         if prior is not None:
             defines.update(self._pure_colour_defines(prior))

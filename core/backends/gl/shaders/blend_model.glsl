@@ -22,6 +22,37 @@ const float SPREAD_TIE = 1e-3;        // a start further by less is a tie: the f
 const float SPREAD_TIE_FLOOR = 1e-6;
 const float UNTOUCHED_EXTREMES = 0.1;  // F moved the extremes by at most this: untouched_factor applies
 const float KEPT_EXTREMES = 0.1;       // ... and towards O applies (toward_original)
+#if BEST_PAIR
+// Where the principal line misses the centre by more than BEST_PAIR_MISS sigma_d, the pair of
+// neighbours that explains it best (twin: best_pair in aarecovery/spec/blend_model.py).
+const float BEST_PAIR_MISS = 0.1;
+const float BEST_PAIR_GAIN = 0.5;
+const float BEST_PAIR_SPAN = 0.5;
+const float BEST_PAIR_COVERAGE = 0.02;
+const float BEST_PAIR_TIE = 2e-2;       // on squared misses
+const float BEST_PAIR_TIE_FLOOR = 1e-5;
+
+// The best pair so far: its squared miss of the centre, the centre's coverage of its first
+// colour, and the two neighbours' indices (first < second).
+struct BestPair { float miss_sq; float alpha; int a; int b; };
+
+// Pair (i, j) of neighbours replaces `best` where it spans at least `least_span` (squared),
+// holds the centre strictly inside and misses it by less, beyond a near tie. The miss is
+// measured as the line's is (the blend minus the centre): by Pythagoras from dot products it
+// cancelled to 3e-8, and near ties fell on either side between the backends.
+void try_pair(inout BestPair best, vec4 centre, vec4 c_i, vec4 c_j, int i, int j, float least_span) {
+    vec4 pair_span = c_i - c_j;
+    float span_sq = dot(pair_span, pair_span);
+    if (span_sq < least_span) return;
+    float pair_alpha = dot(centre - c_j, pair_span) / span_sq;
+    vec4 blend = pair_alpha * c_i + (1.0 - pair_alpha) * c_j - centre;
+    float miss_sq = dot(blend, blend);
+    if (pair_alpha > BEST_PAIR_COVERAGE && pair_alpha < 1.0 - BEST_PAIR_COVERAGE
+        && miss_sq < best.miss_sq - max(best.miss_sq * BEST_PAIR_TIE, BEST_PAIR_TIE_FLOOR)) {
+        best = BestPair(miss_sq, pair_alpha, i, j);
+    }
+}
+#endif
 
 struct BlendFit {
     vec4 model;           // alpha, beta, the extremes' offsets (+ 81, 162: pure colours), residual
@@ -145,6 +176,40 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
     float alpha = span_sq > TINY ? clamp(dot(c[0] - c_b, span) / span_sq, 0.0, 1.0) : 0.5;
     vec4 miss = alpha * c_a + (1.0 - alpha) * c_b - c[0];
     float residual = sqrt(dot(miss, miss));
+#if BEST_PAIR
+    if (residual > BEST_PAIR_MISS * sigma_d) {
+        float largest_miss = BEST_PAIR_GAIN * residual;
+        BestPair best = BestPair(largest_miss * largest_miss, alpha, a, b);
+        float least_span = (BEST_PAIR_SPAN * BEST_PAIR_SPAN) * span_sq;
+        // Each pair named with constant indices: an index into c[] that the compiler cannot
+        // resolve (a loop it does not unroll) puts c[] in memory for the whole shader.
+        try_pair(best, c[0], c[1], c[2], 1, 2, least_span); try_pair(best, c[0], c[1], c[3], 1, 3, least_span);
+        try_pair(best, c[0], c[1], c[4], 1, 4, least_span); try_pair(best, c[0], c[1], c[5], 1, 5, least_span);
+        try_pair(best, c[0], c[1], c[6], 1, 6, least_span); try_pair(best, c[0], c[1], c[7], 1, 7, least_span);
+        try_pair(best, c[0], c[1], c[8], 1, 8, least_span); try_pair(best, c[0], c[2], c[3], 2, 3, least_span);
+        try_pair(best, c[0], c[2], c[4], 2, 4, least_span); try_pair(best, c[0], c[2], c[5], 2, 5, least_span);
+        try_pair(best, c[0], c[2], c[6], 2, 6, least_span); try_pair(best, c[0], c[2], c[7], 2, 7, least_span);
+        try_pair(best, c[0], c[2], c[8], 2, 8, least_span); try_pair(best, c[0], c[3], c[4], 3, 4, least_span);
+        try_pair(best, c[0], c[3], c[5], 3, 5, least_span); try_pair(best, c[0], c[3], c[6], 3, 6, least_span);
+        try_pair(best, c[0], c[3], c[7], 3, 7, least_span); try_pair(best, c[0], c[3], c[8], 3, 8, least_span);
+        try_pair(best, c[0], c[4], c[5], 4, 5, least_span); try_pair(best, c[0], c[4], c[6], 4, 6, least_span);
+        try_pair(best, c[0], c[4], c[7], 4, 7, least_span); try_pair(best, c[0], c[4], c[8], 4, 8, least_span);
+        try_pair(best, c[0], c[5], c[6], 5, 6, least_span); try_pair(best, c[0], c[5], c[7], 5, 7, least_span);
+        try_pair(best, c[0], c[5], c[8], 5, 8, least_span); try_pair(best, c[0], c[6], c[7], 6, 7, least_span);
+        try_pair(best, c[0], c[6], c[8], 6, 8, least_span); try_pair(best, c[0], c[7], c[8], 7, 8, least_span);
+        if (best.a != a || best.b != b) {
+            a = best.a; b = best.b; alpha = best.alpha;
+            for (int i = 1; i < 9; ++i) {
+                if (i == a) { c_a = c[i]; f_a = f[i]; offset_a = OFFSETS[i]; }
+                if (i == b) { c_b = c[i]; f_b = f[i]; offset_b = OFFSETS[i]; }
+            }
+            residual = sqrt(best.miss_sq);
+            // F's change at the extremes, of the pair taken.
+            moved_ab = max(abs(f_a - c_a), abs(f_b - c_b));
+            moved_extremes = max(max(moved_ab.r, moved_ab.g), max(moved_ab.b, moved_ab.a));
+        }
+    }
+#endif
     // The extremes' offsets as base-3 digits (x and y of a, then of b); jacobi.glsl decodes them.
     float code = float((offset_a.x + 1) + 3 * (offset_a.y + 1) + 9 * (offset_b.x + 1) + 27 * (offset_b.y + 1));
 #if PURE_COLOURS
