@@ -12,7 +12,6 @@ import pytest
 
 import aarecovery
 from aarecovery.spec import blend_model
-from aarecovery.spec.neighbourhood import NEIGHBOUR_OFFSETS
 
 SIGMA_D = aarecovery.PARAMETERS["sigma_d"].default
 
@@ -101,7 +100,3 @@ def test_the_paper_and_a_jpeg_original_keep_the_lines_extremes():
     engine.set_images(decoded, filtered, quantization=tables)
     assert not engine.plan().best_pair
 
-
-def test_neighbour_order_names_the_pairs():
-    # best_pair's indices are NEIGHBOUR_OFFSETS positions, as the Jacobi step gathers them.
-    assert NEIGHBOUR_OFFSETS[1] == (-1, 0) and NEIGHBOUR_OFFSETS[4] == (1, 0)
