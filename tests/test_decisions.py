@@ -40,6 +40,16 @@ def _channel_mixer():
     return original, linear_to_srgb(np.clip(mixed, 0, 1))
 
 
+def _indexed_map():
+    """A colour map drawing converted to indexed colour: its own 6 colours, no dithering."""
+    from PIL import Image
+
+    original = _drawing("maps", 128)
+    pixels = Image.fromarray(np.rint(original * 255).astype(np.uint8))
+    indexed = pixels.quantize(colors=6, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
+    return original, np.asarray(indexed.convert("RGB"), np.float32) / 255
+
+
 def _jpeg_page_thresholded(quality=85):
     """A page of serif text saved as a JPEG and decoded, then thresholded: a scan's workflow."""
     import io
@@ -87,6 +97,7 @@ PAIRS = {
     Decision.NEIGHBOURHOOD_MIXED: lambda: (_drawing("poster"), aarecovery.filters.apply("unsharp", _drawing("poster"))),
     Decision.COLOUR_MAP_KEPT: lambda: (_drawing("maps"), _saturate(_drawing("maps"), 1.5)),
     Decision.COLOUR_MAP_CALIBRATED: _quantised_photo,
+    Decision.COLOUR_MAP_HARD_EDGED: _indexed_map,
     Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT: lambda: (_drawing("pies"), _saturate(_drawing("pies"), 1.1)),
     Decision.NEIGHBOURHOOD_HARD_EDGED: lambda: _case("shapes", "bilateral"),
 }

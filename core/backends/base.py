@@ -60,6 +60,9 @@ class Decision(str, enum.Enum):
     own error: F is kept."""
     COLOUR_MAP_CALIBRATED = "colour-map-calibrated"
     """A colour map (a palette quantiser) on a textured image: the calibrated strength."""
+    COLOUR_MAP_HARD_EDGED = "colour-map-hard-edged"
+    """A colour map (a palette quantiser) on hard-edged content: full strength, or on a JPEG
+    original the calibrated strength; no pure colours."""
     NEIGHBOURHOOD_HARD_EDGED_KEPT = "neighbourhood-hard-edged-kept"
     """A neighbourhood filter on hard-edged content whose repairs would be no larger than the
     model's own error: F is kept."""

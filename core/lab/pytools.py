@@ -110,6 +110,13 @@ def _pil_unsharp(pil, image, p):
                                                     threshold=int(p["threshold"])))
 
 
+def _pil_quantize(pil, image, p):
+    # A palette of a few colours by median cut, each pixel mapped to its nearest entry without
+    # dithering: what indexed-colour conversion does (GIF, PNG-8, GIMP's Image > Mode > Indexed).
+    return image.quantize(colors=int(p["colours"]), method=pil.Image.Quantize.MEDIANCUT,
+                          dither=pil.Image.Dither.NONE).convert("RGB")
+
+
 def _pil_gradient_map(pil, image, p):
     # A duotone: grey to a dark blue through orange to a pale yellow.
     return pil.ImageOps.colorize(pil.ImageOps.grayscale(image), black=(20, 24, 80), white=(255, 248, 200),
@@ -197,4 +204,4 @@ OPENCV = PythonTool("opencv", "OpenCV", "cv2", "opencv-python-headless",
 PILLOW = PythonTool("pillow", "Pillow (ImageOps, ImageFilter)", "PIL", "Pillow",
                     {"posterize": _pil_posterize, "solarize": _pil_solarize, "equalize": _pil_equalize,
                      "ycbcr-equalize": _pil_ycbcr_equalize, "autocontrast": _pil_autocontrast, "unsharp": _pil_unsharp,
-                     "gradient-map": _pil_gradient_map}, _run_pillow)
+                     "gradient-map": _pil_gradient_map, "quantize": _pil_quantize}, _run_pillow)

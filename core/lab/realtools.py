@@ -237,6 +237,9 @@ TOOL_FILTERS = {f.name: f for f in (
     # A point-wise filter that no per-channel or one-key table explains: the luma of YCbCr
     # equalized, the chroma kept (F = O + s(Rec. 601 luma) in every channel, clipped).
     _tf("pil-ycbcr-equalize", "pillow", ["ycbcr-equalize"], "equalize", "tune", whole_image=True),
+    # A palette quantiser (indexed colour, no dithering): a point-wise map of the whole colour
+    # that no table of one key explains on a colour image.
+    _tf("pil-quantize", "pillow", ["quantize", "colours=6"], "posterize", "tune", whole_image=True),
     # Held out: edge-preserving smoothing, detail enhancement, equalization and a TURBO colour
     # map of the grey value; Pillow's equalize, unsharp mask and a gradient map.
     _tf("cv-edge-preserving", "opencv", ["edge-preserving", "flags=1", "sigma_s={sigma}", "sigma_r=0.4"], "abstraction",
@@ -323,9 +326,9 @@ REAL_FULL = RealToolsSuite("realtools", _ALL_FAMILIES, _ALL_FILTERS, 96,
 #: and for quick checks while tuning. Of the
 #: filters added with OpenCV and Pillow it runs one neighbourhood filter per half, and a
 #: non-monotonic curve (tune) or the scanning threshold (held out): each filter adds ten
-#: cases to a half, and the other eleven would nearly double its time.
+#: cases to a half, and the others would nearly double its time.
 _QUICK_LEAVES_OUT = {"cv-smoothing", "cv-gamma", "cv-jet", "cv-threshold", "pil-posterize", "pil-autocontrast",
-                     "cv-detail-enhance", "cv-equalize", "cv-turbo", "pil-equalize", "pil-unsharp", "pil-gradient-map"}
+                     "cv-detail-enhance", "cv-equalize", "cv-turbo", "pil-equalize", "pil-unsharp", "pil-gradient-map", "pil-quantize"}
 REAL_QUICK = RealToolsSuite("realtools-quick", ("maps", "starburst", "text", "coffee", "poster", "hatching", "pies",
                                                 "towers", "rocket", "banner"),
                             tuple(f for f in _ALL_FILTERS if f not in _QUICK_LEAVES_OUT), 64,

@@ -37,7 +37,7 @@ colour lines better), then takes the first of these exits that applies, each nam
    colour map of all three channels at once (``colour_map``): it cannot be simulated and
    the model would flatten the texture, F is kept. ``NEIGHBOURHOOD_MIXED``
    (``mixed_content``): the same where text or drawings cover part of the photo: they are
-   repaired as step 10 would (0.75 under a smoothing filter; pure colours where the filter
+   repaired as step 11 would (0.75 under a smoothing filter; pure colours where the filter
    keeps flat colours, in the drawn regions only), F kept in the photo (the local plan with
    a textured strength of 0, or under a sharpening filter the low strength that follows).
    ``NEIGHBOURHOOD_TEXTURED``: a grey textured image under any such filter, or a colour one
@@ -49,7 +49,11 @@ colour lines better), then takes the first of these exits that applies, each nam
 9. ``NEIGHBOURHOOD_HARD_EDGED_KEPT``: a neighbourhood filter on hard-edged content whose
    repairs are no larger than the model's own error (a stricter bar for a smoothing filter on
    a compressed O): F is kept.
-10. ``NEIGHBOURHOOD_HARD_EDGED``: a neighbourhood filter on hard-edged content: the paper's
+10. ``COLOUR_MAP_HARD_EDGED``: a colour map of all three channels at once (a palette
+    quantiser) on hard-edged content, told from neighbourhood filters by a higher share
+    (``colour_map.HARD_EDGED_COLOUR_MAP_SHARE``): full strength, or from a JPEG the
+    calibrated strength; no pure colours.
+11. ``NEIGHBOURHOOD_HARD_EDGED``: a neighbourhood filter on hard-edged content: the paper's
     passes at full strength (lower for a smoothing filter, and none where it left O's pixel
     as it was: ``smoothing``) and, where the
     filter keeps flat colours (sharpening, edge-aware smoothing), the pure colours of thin
@@ -78,7 +82,7 @@ from ..spec.local_plan import FLAT_SPAN, LocalStrength
 from ..spec.sobel import gradient_magnitude
 from .blend_space import choose_blend_space, means_tell_srgb
 from .calibration import EDGE_GRADIENT, calibrate_strength
-from .colour_map import COLOUR_MAP_SHARE, fit_colour_map
+from .colour_map import COLOUR_MAP_SHARE, HARD_EDGED_COLOUR_MAP_SHARE, fit_colour_map
 from .compression import (COMPRESSED_HARD_EDGED_BLEND_SPACE, COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SHARPENED_BLEND_SPACE,
                           COMPRESSED_SHARPENED_STRENGTH, COMPRESSED_SMOOTHED_BLEND_SPACE, COMPRESSED_SMOOTHED_STRENGTH,
                           GRID_MARGIN, compression_evidence, hidden_compression)
@@ -596,6 +600,29 @@ def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterat
                                         f"{needed:g}" + (f" above {compression.describe()}" if compression.compressed
                                                          else "") + "): kept F", Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT,
                             forcing=forcing_advice(Decision.NEIGHBOURHOOD_HARD_EDGED_KEPT, ratio))
+    # A palette quantiser (indexed colour without dithering: Pillow's quantize, G'MIC's
+    # -quantize, GIMP's Image > Mode > Indexed) maps each whole colour to its nearest palette
+    # entry: point-wise, though no table of one key explains it on a colour drawing. Taken for
+    # a neighbourhood filter, its flat palette colours read as a smoothing filter that keeps
+    # flat colours (identity pure colours, strength 0.75, F kept where it left O's pixel):
+    # tuning half, the map under Pillow's quantize lost 0.66 dB against F (linear light) and
+    # kept 0.08 of its error (sRGB), where the paper's passes at full strength remove 0.455
+    # and 0.365. The 3-D table (plan/colour_map.py) tells it from the neighbourhood filters at
+    # a higher share than on a photo (HARD_EDGED_COLOUR_MAP_SHARE): full strength, or on a
+    # JPEG the strength calibrated with that table; no pure colours (the backends' tables
+    # have one key).
+    colour_map = fit_colour_map(o, f, edges)
+    if colour_map.consistency >= HARD_EDGED_COLOUR_MAP_SHARE:
+        why = (f"point-wise colour map ({colour_map.consistency:.3f} of edges match, repair-to-error ratio "
+               f"{ratio:.1f}) on hard-edged content")
+        if compression.compressed:
+            strength, errors = calibrate_strength(o, colour_map, f, space, sigma_d, sigma_e, iterations)
+            return PairAnalysis(space, strength, why + f" above {compression.describe()}; half-resolution "
+                                                       f"calibration chose strength {strength:g}",
+                                Decision.COLOUR_MAP_HARD_EDGED,
+                                forcing=forcing_advice(Decision.COLOUR_MAP_HARD_EDGED, errors=errors) if strength == 0
+                                else None)
+        return PairAnalysis(space, 1.0, why + ": full strength", Decision.COLOUR_MAP_HARD_EDGED)
     # A smoothing filter also leaves some edges as O had them (a bilateral filter's strong
     # edges), and so does the reference: there the confidence falls to 0 (UNTOUCHED_SPAN, in
     # the model's pass).

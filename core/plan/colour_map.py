@@ -18,7 +18,7 @@ import numpy as np
 
 from ..colour import largest_channel
 
-__all__ = ["ColourMapTransfer", "fit_colour_map", "COLOUR_MAP_SHARE"]
+__all__ = ["ColourMapTransfer", "fit_colour_map", "COLOUR_MAP_SHARE", "HARD_EDGED_COLOUR_MAP_SHARE"]
 
 # Bins per channel: 8/255 wide, not swept. Finer bins hold fewer pixels each to leave one out
 # of (a 512 x 512 crop has 8 pixels per bin of 32^3 on average); coarser ones straddle more
@@ -30,6 +30,13 @@ _MATCH = 3.0 / 255
 #: hue-chroma on PNG drawings) score 0.917-0.975, neighbourhood filters (unsharp mask,
 #: bilateral) at most 0.712, JPEG sources under hue-chroma 0.66-0.70.
 COLOUR_MAP_SHARE = 0.85
+#: The same share on hard-edged content, where a filter the point-wise tables do not explain
+#: is otherwise taken for a neighbourhood filter: a palette quantiser scores 0.92-0.99 there
+#: (tuning half, Pillow's median-cut quantize to 6 colours on PNG drawings and scans: the maps
+#: 0.922-0.950, icons 0.976-0.987), GEGL's hue-chroma 0.917-0.990, but a bilateral filter on
+#: flat-coloured drawings reaches 0.875 (OpenCV's, the icons), and the other neighbourhood
+#: filters (unsharp masks, G'MIC's bilateral, OpenCV's smoothing) at most 0.806.
+HARD_EDGED_COLOUR_MAP_SHARE = 0.9
 
 
 class ColourMapTransfer:
