@@ -9,9 +9,11 @@ pixels leaving each pixel out of its own bin, so that a bin holding one pixel (e
 fits its own pixel) proves nothing. Neighbourhood filters, whose output at one colour
 depends on the pixel's surroundings, score far lower (measured below).
 
-The table serves self-calibration on textured images (``plan.calibration``), which
-applies ``f`` to colours O does not hold (blends at half resolution); empty bins take
-the mean of their filled neighbours, grown outwards.
+The table serves self-calibration on textured images and JPEG drawings
+(``plan.calibration``), which applies ``f`` to colours O does not hold (blends at half
+resolution); empty bins take the mean of their filled neighbours, grown outwards. On
+hard-edged content its share alone tells a colour map from a neighbourhood filter
+(:data:`HARD_EDGED_COLOUR_MAP_SHARE`).
 """
 
 import numpy as np
@@ -31,9 +33,10 @@ _MATCH = 3.0 / 255
 #: bilateral) at most 0.712, JPEG sources under hue-chroma 0.66-0.70.
 COLOUR_MAP_SHARE = 0.85
 #: The same share on hard-edged content, where a filter the point-wise tables do not explain
-#: is otherwise taken for a neighbourhood filter: a palette quantiser scores 0.92-0.99 there
+#: is otherwise taken for a neighbourhood filter: a palette quantiser scores 0.91-0.99 there
 #: (tuning half, Pillow's median-cut quantize to 6 colours on PNG drawings and scans: the maps
-#: 0.922-0.950, icons 0.976-0.987), GEGL's hue-chroma 0.917-0.990, but a bilateral filter on
+#: 0.922-0.950, icons 0.976-0.987, the star burst 0.909-0.917; the sRGB notice page 0.859, which
+#: a one-key table explains first), GEGL's hue-chroma 0.917-0.990, but a bilateral filter on
 #: flat-coloured drawings reaches 0.875 (OpenCV's, the icons), and the other neighbourhood
 #: filters (unsharp masks, G'MIC's bilateral, OpenCV's smoothing) at most 0.806.
 HARD_EDGED_COLOUR_MAP_SHARE = 0.9
