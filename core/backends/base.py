@@ -119,6 +119,12 @@ class Plan:
         Where the principal colour line misses a pixel, the pair of its neighbours that
         explains it best gives the model's extremes (``aarecovery.spec.blend_model.best_pair``):
         the safe default on a lossless O; False, the paper's extremes.
+    pure_colour_blocks : bool
+        With `pure_colours`: a GL 4.3 backend first lists the blocks where the pure colours'
+        fit can change anything (O's near a possible ridge or a change of F,
+        ``backends/gl/blocks.pure_colour_mask``) and fits those alone, where enough of O's
+        edges lie where F is flat (``aarecovery.plan.fit_blocks``); False: it fits O's active
+        blocks. R is the same either way.
     window : tuple of slice or None
         The rows and columns of the pair that the safe default's analysis read
         (``aarecovery.sample``), when the plan was made from the whole pair: the summary
@@ -141,6 +147,7 @@ class Plan:
     window: tuple = None
     ramp_table: object = None
     best_pair: bool = False
+    pure_colour_blocks: bool = False
 
     @property
     def keeps_filtered(self):

@@ -73,4 +73,5 @@ def make_plan(original, filtered, parameters, *, mode="safe", linear=False, blen
                 toward_original=analysis.toward_original and asked is None, forcing=analysis.forcing,
                 # The ramp lookup's delta is in sRGB-encoded values, the table's.
                 ramp_table=None if linear else analysis.ramp_table, best_pair=analysis.best_pair,
+                pure_colour_blocks=analysis.pure_colour_blocks and prior is not None,
                 reason=analysis.reason + ("" if asked is None else f"; strength {asked:g} as asked instead"))

@@ -86,6 +86,7 @@ from .colour_map import COLOUR_MAP_SHARE, HARD_EDGED_COLOUR_MAP_SHARE, fit_colou
 from .compression import (COMPRESSED_HARD_EDGED_BLEND_SPACE, COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SHARPENED_BLEND_SPACE,
                           COMPRESSED_SHARPENED_STRENGTH, COMPRESSED_SMOOTHED_BLEND_SPACE, COMPRESSED_SMOOTHED_STRENGTH,
                           GRID_MARGIN, compression_evidence, hidden_compression)
+from .fit_blocks import pure_colour_blocks_pay
 from .flat_colours import flat_colour_prior
 from .forcing import forcing_advice
 from .hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screentone_drawing
@@ -216,6 +217,9 @@ class PairAnalysis:
     best_pair : bool
         The model's extremes from the pair of neighbours that explains a pixel best where the
         principal line misses it (``aarecovery.spec.blend_model.best_pair``): on a lossless O.
+    pure_colour_blocks : bool
+        With pure colours on the whole image: the GL backend fits only the blocks where they
+        can change anything (``aarecovery.plan.fit_blocks``, ``Plan.pure_colour_blocks``).
     """
 
     blend_space: str
@@ -230,6 +234,7 @@ class PairAnalysis:
     toward_original: bool = False
     ramp_table: object = None
     best_pair: bool = False
+    pure_colour_blocks: bool = False
 
 
 def analysis_crop(image):
@@ -286,7 +291,11 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # none up (the space photo under GEGL's unsharp mask 0.318 -> 0.296); held out, 9 down
     # and 2 up (0.103 -> 0.091), which was seen after the choice above and decided this one.
     lossless = not any(reading.compressed for reading in readings)
-    return replace(analysis, best_pair=lossless and analysis.decision is not Decision.NEIGHBOURHOOD_TEXTURED)
+    prior = analysis.pure_colours
+    listed = (prior is not None and not prior.drawn_only
+              and pure_colour_blocks_pay(analysis_crop(original_rgba), analysis_crop(filtered_rgba)))
+    return replace(analysis, best_pair=lossless and analysis.decision is not Decision.NEIGHBOURHOOD_TEXTURED,
+                   pure_colour_blocks=listed)
 
 
 def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterations, quantization, readings):

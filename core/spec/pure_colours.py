@@ -83,7 +83,7 @@ from .sobel import ridge_magnitude, sobel_magnitude
 
 __all__ = ["PureColourPrior", "is_flat_colour", "PALETTE_SIZE", "INK_COUNT", "ON_LINE_TOLERANCE", "KEPT_CONTRAST", "EXTENSION_KEYS",
            "SCALE_KEYS", "SHIFT_KEYS", "filtered_colour", "transfer_encoded", "extend_extreme", "scale_transfer", "key_values", "shift_grey",
-           "rec601_grey", "fit_pure_colour_model", "RIDGE_EDGE_SCALE"]
+           "rec601_grey", "fit_pure_colour_model", "RIDGE_EDGE_SCALE", "possible_ridges"]
 
 #: Most palette colours kept (a uniform array in the GL pass).
 PALETTE_SIZE = 32
@@ -514,6 +514,56 @@ def is_flat_colour(colour, palette, prior):
         if luma > 0:
             flat |= np.abs(miss[0] * LUMA_WEIGHTS[0] + miss[1] * LUMA_WEIGHTS[1] + miss[2] * LUMA_WEIGHTS[2]) < luma
     return flat
+
+
+#: Rounding room of :func:`possible_ridges`: its bound leaves this much, on squared working-space
+#: distances, to the float arithmetic of :func:`extend_extreme`'s line and ridge tests.
+RIDGE_BOUND_SLACK = 1e-4
+
+
+def possible_ridges(colours, floor=0.0):
+    """bool ``(H, W)``: where :func:`extend_extreme` could find a ridge, whatever the other extreme.
+
+    A necessary condition of its ridge test at pixel q, from O alone: an opposite pair of
+    q's neighbours n1, n2 lies within :data:`LINE_TOLERANCE` of the line through the two
+    extremes, and lower than q along it. With a = O(q) - O(n1) and b = O(q) - O(n2), each
+    lies within that distance of the line's direction and points along it, so the angle
+    between them is at most the sum of the angles each may make with the line:
+    ``a . b >= sqrt(|a|^2 - L^2) sqrt(|b|^2 - L^2) - min(|a|, L) min(|b|, L)`` (the first
+    product 0 where a side is within L), with neither a nor b zero, nor shorter than the
+    ridge's noise margin (`floor`: both lie lower than q by more). A straight edge's
+    neighbours across it (one brighter, one darker) fail it, and so do flat areas: on a
+    4096 x 4096 pair of filled shapes and strokes, 0.3 % of the pixels pass, and the blocks
+    within reach of them are a third of O's active ones. The GL backend fits pure colours only
+    in O's blocks near such a pixel or near a change of F (``blocks.pure_colour_mask``):
+    elsewhere the fit gives F exactly. Image borders pass nowhere, as in the ridge test.
+
+    Parameters
+    ----------
+    colours : list of 9 ndarray of float32, shape (4, H, W)
+        O's working-space neighbourhood (``aarecovery.spec.neighbourhood.neighbours``).
+    floor : float
+        :data:`RIDGE_NOISE_MARGIN` times the prior's ``ridge_noise`` (0 on a lossless O).
+
+    Returns
+    -------
+    ndarray of bool, shape (H, W)
+    """
+    slack = np.float32(RIDGE_BOUND_SLACK)
+    line_sq = np.float32(LINE_TOLERANCE) * np.float32(LINE_TOLERANCE) + slack
+    zero = np.float32(0)
+    floor_sq = np.float32(floor) * np.float32(floor)
+    possible = np.zeros(colours[0].shape[1:], bool)
+    for i, j in OPPOSITE_PAIRS:
+        a, b = colours[0] - colours[i], colours[0] - colours[j]
+        a_sq, b_sq = dot(a, a), dot(b, b)
+        along = np.sqrt(np.maximum(a_sq - line_sq, zero)) * np.sqrt(np.maximum(b_sq - line_sq, zero))
+        across = np.sqrt(np.minimum(a_sq, line_sq)) * np.sqrt(np.minimum(b_sq, line_sq))
+        possible |= (a_sq > floor_sq) & (b_sq > floor_sq) & (a_sq > zero) & (b_sq > zero) \
+            & (dot(a, b) >= along - across - slack)
+    possible[0, :] = possible[-1, :] = False
+    possible[:, 0] = possible[:, -1] = False
+    return possible
 
 
 def extend_extreme(far, near, around, filtered_far, on_border, palette, prior, blend_space, gate=None):

@@ -12,8 +12,12 @@ turns a block mask made on the GPU into lists.
 
 import numpy as np
 
+from ...spec.neighbourhood import neighbours, planes
+from ...spec.pure_colours import possible_ridges
+
 __all__ = ["BLOCK_SIDE", "MARGIN", "LISTS", "DRAW_COMMAND_WORDS", "DISPATCH_COMMAND_WORDS", "active_mask",
-           "active_blocks", "block_lists", "expand_runs", "extreme_offsets", "live_mask"]
+           "active_blocks", "block_lists", "expand_runs", "extreme_offsets", "live_mask", "differing_pixels",
+           "blocks_near", "pure_colour_mask"]
 
 BLOCK_SIDE = 16
 #: Pixels around a block whose differences still wake it (see :func:`active_mask`).
@@ -74,6 +78,71 @@ def active_mask(pixels, side=BLOCK_SIDE, margin=MARGIN):
         active[max(0, dy):rows + min(0, dy), max(0, dx):columns + min(0, dx)] |= \
             hit[max(0, -dy):rows - max(0, dy), max(0, -dx):columns - max(0, dx)]
     return active
+
+
+def differing_pixels(pixels):
+    """bool ``(H, W)``: the pixels whose value differs from a 4-neighbour's (any channel).
+
+    Parameters
+    ----------
+    pixels : ndarray, shape (H, W, C)
+        An image as uploaded.
+    """
+    differs = np.zeros(pixels.shape[:2], bool)
+    across = (pixels[:, 1:] != pixels[:, :-1]).any(axis=-1)
+    down = (pixels[1:] != pixels[:-1]).any(axis=-1)
+    differs[:, 1:] |= across
+    differs[:, :-1] |= across
+    differs[1:] |= down
+    differs[:-1] |= down
+    return differs
+
+
+def blocks_near(mask, side=BLOCK_SIDE, margin=MARGIN):
+    """bool ``(rows, columns)``: the blocks that a true pixel of `mask` lies in or within
+    `margin` pixels of (:func:`active_mask` is ``blocks_near(differing_pixels(pixels))``)."""
+    height, width = mask.shape
+    near = np.zeros((-(-height // side), -(-width // side)), bool)
+    ys, xs = np.nonzero(mask)
+    for dy in (-margin, 0, margin):
+        for dx in (-margin, 0, margin):
+            near[np.clip(ys + dy, 0, height - 1) // side, np.clip(xs + dx, 0, width - 1) // side] = True
+    return near
+
+
+def pure_colour_mask(original_work, original, filtered, floor=0.0, side=BLOCK_SIDE, margin=MARGIN):
+    """Which blocks the pure colours' fit covers (``flag_pure_colour_blocks``, GL 4.3).
+
+    The fit with pure colours gives F exactly, with nothing for a Jacobi step to gather,
+    wherever F is flat around a pixel and none of its neighbours is a thin feature's partial
+    colour: its edge strength is O's gradient times the larger of F's and of the contrast of
+    the two extremes' filtered colours, which differ only where F varies or an extreme was
+    extended, and only a ridge is extended. So of O's active blocks (:func:`active_mask`) it
+    needs those within `margin` of a pixel that could be a ridge
+    (``aarecovery.spec.pure_colours.possible_ridges``) or that differs from a 4-neighbour in
+    F; the margin of 2 holds the extreme (1 pixel) and what a step gathers from it (1 more).
+    A pixel of F that varies beside O's edges lies in O's active blocks, so only those pixels
+    are looked at.
+
+    Parameters
+    ----------
+    original_work : ndarray of float32, shape (H, W, 4)
+        O in the working space.
+    original, filtered : ndarray, shape (H, W, C)
+        O and F as uploaded.
+    floor : float
+        The ridge's noise margin (``possible_ridges``).
+    side, margin : int
+
+    Returns
+    -------
+    ndarray of bool, shape (ceil(H / side), ceil(W / side))
+    """
+    height, width = original_work.shape[:2]
+    fitted = active_mask(original, side, margin)
+    inside = np.kron(fitted, np.ones((side, side), bool))[:height, :width]
+    wakes = possible_ridges(neighbours(planes(original_work)), floor) | differing_pixels(filtered)
+    return fitted & blocks_near(wakes & inside, side, margin)
 
 
 def extreme_offsets(code):

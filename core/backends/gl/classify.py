@@ -53,6 +53,8 @@ _EMPTY_COMMANDS = _commands(dict.fromkeys(LISTS, 0), dict.fromkeys(LISTS, 0))
 FULL_SCREEN_SHARE = 0.9
 # The storage-buffer bindings of the classification shaders.
 _COMMANDS, _FLAGS, _FIRST_LIST = 1, 2, 3
+# O's block flags, read while the pure colours' blocks are flagged (flag_wakes.comp).
+_ORIGINAL_FLAGS = 7
 
 
 def block_grid(size):
@@ -65,6 +67,8 @@ class BlockLists:
 
     Each list's buffer holds ``(column, row)`` pairs of int32; :attr:`commands` holds the
     indirect commands (GL 4.3), or :attr:`counts` the lengths when the CPU made the lists.
+    :attr:`flags` holds a uint32 per block, non-zero where active, when the GPU classified
+    them (GL 4.3): the pure colours' blocks are chosen among O's (``flag_wakes.comp``).
     """
 
     def __init__(self, context, grid):
@@ -72,6 +76,7 @@ class BlockLists:
         capacity = 8 * grid[0] * grid[1]
         self.buffers = {name: context.buffer(reserve=capacity) for name in LISTS}
         self.commands = context.buffer(_EMPTY_COMMANDS)
+        self.flags = context.buffer(reserve=4 * grid[0] * grid[1])
         self.counts = None
         self._blocks = None
 
@@ -111,6 +116,7 @@ class BlockLists:
         for buffer in self.buffers.values():
             buffer.release()
         self.commands.release()
+        self.flags.release()
 
 
 class BlockClassifier:
@@ -131,7 +137,6 @@ class BlockClassifier:
         self.compute = compute
         self.runs = runs
         self._programs = {}
-        self._flags = None
         self._mask_targets = {}
         #: Work groups per row of a dispatch; lists longer than this dispatch several rows.
         self.max_groups = MAX_GROUPS
@@ -157,19 +162,20 @@ class BlockClassifier:
         else:
             self._classify_with_fragments(texture, lists)
 
-    def _classify_with_compute(self, texture, lists):
-        columns, rows = lists.grid
-        if self._flags is None or self._flags.size < 4 * columns * rows:
-            if self._flags is not None:
-                self._flags.release()
-            self._flags = self.context.buffer(reserve=4 * columns * rows)
-        self._flags.clear()
+    @staticmethod
+    def _bind(lists, flags):
+        """`lists` emptied, and bound with `flags` for a pass that flags blocks and the compaction."""
         lists.reset()
         lists.commands.write(_EMPTY_COMMANDS)
-        self._flags.bind_to_storage_buffer(_FLAGS)
+        flags.bind_to_storage_buffer(_FLAGS)
         lists.commands.bind_to_storage_buffer(_COMMANDS)
         for offset, name in enumerate(LISTS):
             lists.buffers[name].bind_to_storage_buffer(_FIRST_LIST + offset)
+
+    def _classify_with_compute(self, texture, lists):
+        columns, rows = lists.grid
+        lists.flags.clear()
+        self._bind(lists, lists.flags)
         texture.use(0)
         flag = self._compute_shader("classify_blocks.comp")
         flag["image"] = 0
@@ -184,12 +190,30 @@ class BlockClassifier:
         Its ``"active"`` list holds the flagged blocks, ``"dilated"`` and ``"inactive"`` the
         same as a classification's (``blocks.block_lists``).
         """
-        lists.reset()
-        lists.commands.write(_EMPTY_COMMANDS)
-        flags.bind_to_storage_buffer(_FLAGS)
-        lists.commands.bind_to_storage_buffer(_COMMANDS)
-        for offset, name in enumerate(LISTS):
-            lists.buffers[name].bind_to_storage_buffer(_FIRST_LIST + offset)
+        self._bind(lists, flags)
+        self._compact(lists)
+
+    def list_near_wakes(self, wakes, original_lists, lists):
+        """Fill `lists` with the blocks of O's active ones (`original_lists`, classified on the
+        GPU) that hold a pixel of `wakes` or lie within the margin of one in another of O's
+        active blocks (``flag_wakes.comp``; twin ``blocks.pure_colour_mask``).
+
+        Parameters
+        ----------
+        wakes : moderngl.Texture
+            Non-zero where a pixel wakes the blocks around it, written over O's active blocks.
+        original_lists, lists : BlockLists
+        """
+        # The marks of a compute pass are fetched here; a fragment pass's need no barrier.
+        self.context.memory_barrier(moderngl.TEXTURE_FETCH_BARRIER_BIT)
+        self._bind(lists, lists.flags)
+        original_lists.flags.bind_to_storage_buffer(_ORIGINAL_FLAGS)
+        wakes.use(0)
+        flag = self._compute_shader("flag_wakes.comp")
+        flag["wakes"] = 0
+        flag["image_size"] = wakes.size
+        flag["block_grid"] = lists.grid
+        flag.run(-(-lists.grid[0] * lists.grid[1] // 64))
         self._compact(lists)
 
     def _compact(self, lists):
@@ -240,6 +264,4 @@ class BlockClassifier:
         for mask, framebuffer in self._mask_targets.values():
             framebuffer.release()
             mask.release()
-        if self._flags is not None:
-            self._flags.release()
-        self._programs, self._mask_targets, self._flags = {}, {}, None
+        self._programs, self._mask_targets = {}, {}

@@ -1,0 +1,47 @@
+// Which pixels wake the pure colours' fit around them: those that could be a thin feature's
+// ridge, or where F varies. The fit covers O's active blocks within 2 pixels of one
+// (flag_wakes.comp lists them); elsewhere it gives F exactly. Twin: pure_colour_mask in
+// backends/gl/blocks.py and possible_ridges in aarecovery/spec/pure_colours.py, which
+// derive the rule. Needs working.glsl first (O in the working space, F as uploaded).
+
+uniform float ridge_floor;  // RIDGE_NOISE_MARGIN times O's ridge noise: 0 on a lossless O
+
+const float RIDGE_LINE_TOLERANCE = 0.05;  // pure_colours.glsl's LINE_TOLERANCE
+const float RIDGE_BOUND_SLACK = 1e-4;
+
+// Opposite neighbours at a and b from the centre (the differences centre - neighbour) can
+// both lie near the extremes' line and below the centre along it.
+bool possible_pair(vec4 a, vec4 b) {
+    float line_sq = RIDGE_LINE_TOLERANCE * RIDGE_LINE_TOLERANCE + RIDGE_BOUND_SLACK;
+    float a_sq = dot(a, a);
+    float b_sq = dot(b, b);
+    float along = sqrt(max(a_sq - line_sq, 0.0)) * sqrt(max(b_sq - line_sq, 0.0));
+    float across = sqrt(min(a_sq, line_sq)) * sqrt(min(b_sq, line_sq));
+    float floor_sq = ridge_floor * ridge_floor;
+    return a_sq > floor_sq && b_sq > floor_sq && a_sq > 0.0 && b_sq > 0.0
+           && dot(a, b) >= along - across - RIDGE_BOUND_SLACK;
+}
+
+bool possible_ridge(ivec2 q, ivec2 size) {
+    if (q.x <= 0 || q.y <= 0 || q.x >= size.x - 1 || q.y >= size.y - 1) return false;
+    vec4 v[9];
+    for (int i = 0; i < 9; ++i) v[i] = original_neighbour(q, i, size);
+    // N/S, W/E, NW/SE, NE/SW, written out (an index from a loop spills v[] on llvmpipe).
+    return possible_pair(v[0] - v[1], v[0] - v[4]) || possible_pair(v[0] - v[2], v[0] - v[3])
+        || possible_pair(v[0] - v[5], v[0] - v[8]) || possible_pair(v[0] - v[6], v[0] - v[7]);
+}
+
+// F as uploaded differs from a 4-neighbour at p (equal there is equal in the working space).
+bool filtered_varies(ivec2 p, ivec2 size) {
+    vec4 here = texelFetch(filtered_image, p, 0);
+    bool varies = false;
+    if (p.x > 0) varies = varies || any(notEqual(here, texelFetch(filtered_image, p - ivec2(1, 0), 0)));
+    if (p.x < size.x - 1) varies = varies || any(notEqual(here, texelFetch(filtered_image, p + ivec2(1, 0), 0)));
+    if (p.y > 0) varies = varies || any(notEqual(here, texelFetch(filtered_image, p - ivec2(0, 1), 0)));
+    if (p.y < size.y - 1) varies = varies || any(notEqual(here, texelFetch(filtered_image, p + ivec2(0, 1), 0)));
+    return varies;
+}
+
+bool wakes_pure_colours(ivec2 p, ivec2 size) {
+    return filtered_varies(p, size) || possible_ridge(p, size);
+}
