@@ -66,7 +66,7 @@ def test_live_blocks_are_the_specifications_and_skip_blocks(thin_text_and_a_lost
             grid = impl._lists["live"].grid
             flags = np.frombuffer(impl._pixel_buffers["live_flags"].read(), np.uint32)[:grid[0] * grid[1]]
             fitted_flags = np.frombuffer(impl._lists["pure_colours"].flags.read(), np.uint32)[:grid[0] * grid[1]]
-    fitted = pure_colour_mask(original_work, original, filtered)
+    fitted = pure_colour_mask(original_work, original, filtered) != 0
     np.testing.assert_array_equal(fitted_flags.reshape(grid[1], grid[0]) != 0, fitted)
     expected = live_mask(model[..., 1], model[..., 2], changed & _fitted(fitted, model.shape), _fitted(fitted, model.shape))
     np.testing.assert_array_equal(flags.reshape(grid[1], grid[0]) != 0, expected)

@@ -66,6 +66,11 @@ TWINS = {
     ("pure_colour_blocks.glsl", "RIDGE_BOUND_SLACK"): pure_colours.RIDGE_BOUND_SLACK,
     ("flag_wakes.comp", "BLOCK_SIDE"): blocks.BLOCK_SIDE,
     ("flag_wakes.comp", "MARGIN"): blocks.MARGIN,
+    ("flag_wakes.comp", "WAKE_RIDGE"): blocks.WAKE_RIDGE,
+    ("flag_wakes.comp", "FIT_PLAIN"): blocks.FIT_PLAIN,
+    ("flag_wakes.comp", "FIT_WHOLE"): blocks.FIT_WHOLE,
+    ("pure_colour_blocks.glsl", "WAKE_FILTERED"): blocks.WAKE_FILTERED,
+    ("pure_colour_blocks.glsl", "WAKE_RIDGE"): blocks.WAKE_RIDGE,
     ("block_lists.glsl", "DRAW_COMMAND_WORDS"): blocks.DRAW_COMMAND_WORDS,
     ("block_lists.glsl", "DISPATCH_COMMAND_WORDS"): blocks.DISPATCH_COMMAND_WORDS,
     ("block_lists.glsl", "LIST_ACTIVE"): blocks.LISTS.index("active"),
@@ -78,7 +83,8 @@ TWINS = {
 def _constant(source, name):
     match = re.search(rf"const\s+\w+\s+{name}\s*=\s*([^;]+);", source)
     assert match, f"no constant {name}"
-    return eval(re.sub(r"vec[34]", "tuple", match.group(1)), {"tuple": lambda *v: v})  # numbers and a / b only
+    value = re.sub(r"(\d)u\b", r"\1", match.group(1))  # unsigned literals
+    return eval(re.sub(r"vec[34]", "tuple", value), {"tuple": lambda *v: v})  # numbers and a / b only
 
 
 @pytest.mark.parametrize("file, name", sorted(TWINS))

@@ -122,9 +122,9 @@ class Plan:
     pure_colour_blocks : bool
         With `pure_colours`: a GL 4.3 backend first lists the blocks where the pure colours'
         fit can change anything (O's near a possible ridge or a change of F,
-        ``backends/gl/blocks.pure_colour_mask``) and fits those alone, where enough of O's
-        edges lie where F is flat (``aarecovery.plan.fit_blocks``); False: it fits O's active
-        blocks. R is the same either way.
+        ``backends/gl/blocks.pure_colour_mask``) and fits those alone, without the extension
+        tests where no ridge could be extended; where that pays (``aarecovery.plan.fit_blocks``).
+        False: it fits O's active blocks whole. R is the same either way.
     window : tuple of slice or None
         The rows and columns of the pair that the safe default's analysis read
         (``aarecovery.sample``), when the plan was made from the whole pair: the summary

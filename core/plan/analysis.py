@@ -218,8 +218,8 @@ class PairAnalysis:
         The model's extremes from the pair of neighbours that explains a pixel best where the
         principal line misses it (``aarecovery.spec.blend_model.best_pair``): on a lossless O.
     pure_colour_blocks : bool
-        With pure colours on the whole image: the GL backend fits only the blocks where they
-        can change anything (``aarecovery.plan.fit_blocks``, ``Plan.pure_colour_blocks``).
+        With pure colours: the GL backend fits only the blocks where they can change anything
+        (``aarecovery.plan.fit_blocks``, ``Plan.pure_colour_blocks``).
     """
 
     blend_space: str
@@ -292,8 +292,8 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
     # and 2 up (0.103 -> 0.091), which was seen after the choice above and decided this one.
     lossless = not any(reading.compressed for reading in readings)
     prior = analysis.pure_colours
-    listed = (prior is not None and not prior.drawn_only
-              and pure_colour_blocks_pay(analysis_crop(original_rgba), analysis_crop(filtered_rgba)))
+    listed = prior is not None and (prior.drawn_only or pure_colour_blocks_pay(analysis_crop(original_rgba),
+                                                                                analysis_crop(filtered_rgba)))
     return replace(analysis, best_pair=lossless and analysis.decision is not Decision.NEIGHBOURHOOD_TEXTURED,
                    pure_colour_blocks=listed)
 

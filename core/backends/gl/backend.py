@@ -18,8 +18,8 @@ non-zero (``blocks.py``): where F is not flat for the paper's model, where O is 
 pure colours (whose edge strength does not need F's gradient); with pure colours and the
 GPU classification, pass 1 covers only those of O's blocks near a pixel that could be a thin
 feature's ridge or where F varies, where the plan asks for it (``pure_colour_blocks.glsl``),
-and pass 2 only the blocks where pass 1 found that a step can change anything
-(``live_blocks.glsl``). Pass 3 covers the other blocks. The block lists are made
+without the extension tests where no ridge could be extended, and pass 2 only the blocks
+where pass 1 found that a step can change anything (``live_blocks.glsl``). Pass 3 covers the other blocks. The block lists are made
 on the GPU when a run first needs them (``classify.py``) and drive the draws and
 dispatches indirectly. On llvmpipe, which shades every covered
 fragment, this is what makes mostly flat results (threshold, posterize) fast; on a GPU it
@@ -452,17 +452,23 @@ class GLBackend:
             defines["TABLE_KEY"] = ramp.key_code
             sources["original_image"] = self._textures["original"]
             sources["transfer_bends"] = self._transfer_bends(ramp)
+        pure_gate = bool(defines.get("PURE_GATE"))
+        split = None
         with self._passes():
-            if active == "pure_colours":
-                lists = self._pure_colour_lists(lists, RIDGE_NOISE_MARGIN * prior.ridge_noise)
+            # Gated pure colours read the gate where they list their blocks: the local plan's
+            # factor first, over O's blocks.
+            if active == "pure_colours" and not pure_gate:
+                lists, split = self._pure_colour_lists(lists, RIDGE_NOISE_MARGIN * prior.ridge_noise, pure_gate)
             if local:
                 drawn_only = prior is not None and prior.drawn_only
                 gated = drawn_only and prior.ink_gate
                 # Towards O reads the gate too: with the drawn ink where no prior's gate decides.
-                self._local_factor(local_plan, None if maps else (lists, active),
+                self._local_factor(local_plan, None if maps else (lists, "original" if pure_gate else active),
                                    ink_gate=gated or (plan.toward_original and not drawn_only),
                                    ink_span=prior.ink_span if gated else FLAT_SPAN,
                                    for_beta=prior is None and not plan.toward_original)
+            if active == "pure_colours" and pure_gate:
+                lists, split = self._pure_colour_lists(lists, RIDGE_NOISE_MARGIN * prior.ridge_noise, pure_gate)
             if maps:
                 self._strength_map(plan)
             if active not in self._working_lists:
@@ -474,7 +480,12 @@ class GLBackend:
             # and their lists cost more than they spare.)
             live = (self._live_blocks() if plan.iterations > 0 and active != "filtered" and self._classifier.compute
                     else None)
-            if plan.iterations > 0 or maps:
+            if (plan.iterations > 0 or maps) and split is not None:
+                # The extension tests only where a ridge could be extended: the same model.
+                for part, no_extension in zip(split, (0, 1)):
+                    self._fit_blend_model(sources, uniforms, {**defines, "NO_EXTENSION": no_extension}, part, maps,
+                                          live, only_listed=True)
+            elif plan.iterations > 0 or maps:
                 self._fit_blend_model(sources, uniforms, defines, lists, maps, live)
             if live is not None:
                 self._timed("live blocks", lambda: self._classifier.list_flagged(*live))
@@ -492,44 +503,56 @@ class GLBackend:
                 self._run_pass("keep_filtered", keep, [result], blocks=lists if live is None else live[1],
                               list_name="inactive", defines=defines)
             if plan.iterations > 0:
-                last_input = self._jacobi_steps(sources, defines, lists if live is None else live[1], plan.iterations)
+                last_input = self._jacobi_steps(sources, defines, lists if live is None else live[1], plan.iterations,
+                                                only_listed=live is not None)
             if ramp is not None:
                 self._ramp_lookup(sources, defines, last_input)
         self._stage("passes")
         self._ran = {"maps": maps}
 
-    def _pure_colour_lists(self, original_lists, ridge_floor):
-        """The blocks the pure colours' fit covers, listed on the GPU once per pair (GL 4.3):
-        O's active blocks (`original_lists`) near a pixel that could be a thin feature's ridge
-        or where F varies (``pure_colour_blocks.glsl``; twin ``blocks.pure_colour_mask``).
-        Elsewhere the fit gives F exactly and nothing to gather. The working space is made
-        over O's dilated blocks first: the flags read O there, and those blocks hold every
-        block the fit over these lists reads.
+    def _pure_colour_lists(self, original_lists, ridge_floor, gated):
+        """The blocks the pure colours' fit covers, listed on the GPU once per pair (GL 4.3),
+        and those of them split by whether a ridge could be extended there.
 
-        On the 4096 x 4096 thin-features pair the fit then covers 20 % of the blocks instead
-        of O's 31 % (F's are 15 %); where every block of O's holds F's edges (a page of text)
-        the listing is all cost, and the plan leaves it out (``aarecovery.plan.fit_blocks``).
-        `ridge_floor`: the ridge's noise margin (``possible_ridges``), which keys the lists.
+        O's active blocks (`original_lists`) near a pixel where F varies or that could be a
+        thin feature's ridge (``pure_colour_blocks.glsl``; twin ``blocks.pure_colour_mask``):
+        elsewhere the fit gives F exactly and nothing to gather. Of those, the blocks with no
+        possible ridge near, or none beside an open gate of drawn content (`gated`: the local
+        plan's factor is made), take the fit without the extension tests, which give nothing
+        there and which llvmpipe runs under a mask wherever it draws. The working space is
+        made over O's dilated blocks first: the wakes read O there, and those blocks hold every
+        block the fit over these lists reads. `ridge_floor`: the ridge's noise margin
+        (``possible_ridges``).
+
+        Returns
+        -------
+        lists : BlockLists
+            Every block the fit covers.
+        split : tuple of two BlockLists
+            Those near a ridge's wake (the whole fit), and the others (no extension).
         """
-        key = ("pure_colours", float(ridge_floor))
-        if key in self._classified:
-            return self._lists["pure_colours"]
-        self._classified -= {name for name in self._classified if isinstance(name, tuple)}
-        self._factor_for = None  # the local plan's factor covers the lists' blocks
-        if "original" not in self._working_lists:
-            self._to_working_space(original_lists, "dilated")
-            self._working_lists.add("original")
-        self._working_lists.add("pure_colours")
-        lists = self._lists_named("pure_colours")
-        original_work, _ = self._working_textures()
-        wakes = self._work("wakes")
-        self._run_pass("flag_pure_colour_blocks", {"original_work": original_work,
-                                                  "filtered_image": self._textures["filtered"]},
-                      [wakes], blocks=original_lists, list_name="active", uniforms={"ridge_floor": key[1]},
-                      defines=self._defines)
-        self._timed("pure colour blocks", lambda: self._classifier.list_near_wakes(wakes, original_lists, lists))
-        self._classified.add(key)
-        return lists
+        key = ("pure_colours", float(ridge_floor), gated)
+        parts = ("pure_colours", "pure_colour_ridges", "pure_colour_plain")
+        if key not in self._classified:
+            self._classified -= {name for name in self._classified if isinstance(name, tuple)}
+            if not gated:
+                self._factor_for = None  # the local plan's factor covers the lists' blocks
+            if "original" not in self._working_lists:
+                self._to_working_space(original_lists, "dilated")
+                self._working_lists.add("original")
+            self._working_lists.add("pure_colours")
+            lists, ridges, plain = (self._lists_named(name) for name in parts)
+            original_work, _ = self._working_textures()
+            inputs = {"original_work": original_work, "filtered_image": self._textures["filtered"]}
+            wakes = self._work("wakes")
+            self._run_pass("flag_pure_colour_blocks", inputs, [wakes], blocks=original_lists, list_name="active",
+                          uniforms={"ridge_floor": key[1]}, defines=self._defines)
+            gate = self._work("strength_factor") if gated else None
+            self._timed("pure colour blocks", lambda: self._classifier.list_near_wakes(
+                wakes, original_lists, lists, (ridges, plain), gate))
+            self._classified.add(key)
+        lists, ridges, plain = (self._lists[name] for name in parts)
+        return lists, (ridges, plain)
 
     def _local_factor(self, local, blocks=None, ink_gate=False, ink_span=FLAT_SPAN, for_beta=False):
         """The local plan's factor of beta for the loaded O, once per pair and plan (three passes).
@@ -566,6 +589,8 @@ class GLBackend:
             self._run_pass("local_plan", inputs, [self._work(output)], uniforms=uniforms,
                           defines={**defines, **beta_only, "LOCAL_PASS": number}, **where)
         self._factor_for = (local, ink_gate, ink_span, for_beta, blocks and blocks[1])
+        # Gated pure colours listed their blocks by this factor's gate.
+        self._classified -= {name for name in self._classified if isinstance(name, tuple) and name[2]}
 
     def _strength_map(self, plan):
         """The strength map of the maps: the plan's strength times the local factor (read back)."""
@@ -627,7 +652,7 @@ class GLBackend:
         flags.clear()
         return flags, lists
 
-    def _fit_blend_model(self, sources, uniforms, defines, lists, maps, live=None):
+    def _fit_blend_model(self, sources, uniforms, defines, lists, maps, live=None, only_listed=False):
         """The model and the first Jacobi iterate (and the edge map, the Jacobi steps' constant with pure colours);
         with `live` (flags, lists), the blocks whose Jacobi steps can change anything flagged."""
         pure = defines["JACOBI_CONSTANT"]
@@ -646,16 +671,19 @@ class GLBackend:
             uniforms = {**uniforms, "live_columns": live[1].grid[0]}
         self._run_pass("fit_blend_model", sources, outputs, blocks=lists, list_name="active", uniforms=uniforms,
                       defines={**defines, "MAPS": int(maps), "SHARED_TILE": int(self.shared_tile),
-                               "LIVE_BLOCKS": int(live is not None), **locations})
+                               "LIVE_BLOCKS": int(live is not None), **locations},
+                      only_listed=only_listed)
 
-    def _jacobi_steps(self, sources, defines, lists, iterations):
+    def _jacobi_steps(self, sources, defines, lists, iterations, only_listed=False):
         """Iterations 2..n ping-pong between two textures; the last writes the result.
 
         R1 from R0 = F is the fit's first iterate; with one iteration the last pass forms it
         again, reading F itself. Every value a step gathers lies in a listed block, where the
         step before wrote it: in an active block (the margin of ``blocks.active_mask``), and
         with the fit's live blocks in one of those (``live_blocks.glsl`` flags the blocks of
-        both gathers). Returns the texture the last step read.
+        both gathers). Returns the texture the last step read. `only_listed`: the live blocks
+        even where they are nearly all (one triangle over every pixel would read the model
+        where no fit wrote it this tile).
         """
         inputs = {**sources, "model_map": self._work("model")}
         if defines["JACOBI_CONSTANT"]:
@@ -669,7 +697,7 @@ class GLBackend:
             else:
                 target = self._work("iterate_b" if previous is self._textures.get("iterate_a") else "iterate_a")
             self._run_pass("jacobi_step", {**inputs, "previous_iterate": previous}, [target], blocks=lists,
-                          list_name="active", defines={**defines, "FINAL": int(final)})
+                          list_name="active", defines={**defines, "FINAL": int(final)}, only_listed=only_listed)
             previous = target
         return step_input
 

@@ -17,7 +17,7 @@ from ...spec.pure_colours import possible_ridges
 
 __all__ = ["BLOCK_SIDE", "MARGIN", "LISTS", "DRAW_COMMAND_WORDS", "DISPATCH_COMMAND_WORDS", "active_mask",
            "active_blocks", "block_lists", "expand_runs", "extreme_offsets", "live_mask", "differing_pixels",
-           "blocks_near", "pure_colour_mask"]
+           "blocks_near", "pure_colour_mask", "WAKE_FILTERED", "WAKE_RIDGE", "FIT_PLAIN", "FIT_WHOLE"]
 
 BLOCK_SIDE = 16
 #: Pixels around a block whose differences still wake it (see :func:`active_mask`).
@@ -110,19 +110,29 @@ def blocks_near(mask, side=BLOCK_SIDE, margin=MARGIN):
     return near
 
 
-def pure_colour_mask(original_work, original, filtered, floor=0.0, side=BLOCK_SIDE, margin=MARGIN):
-    """Which blocks the pure colours' fit covers (``flag_pure_colour_blocks``, GL 4.3).
+#: The bits by which a pixel wakes the pure colours' fit around it (``pure_colour_blocks.glsl``):
+#: F varies there; it could be a thin feature's ridge.
+WAKE_FILTERED, WAKE_RIDGE = 1, 2
+#: The codes of :func:`pure_colour_mask`: a block the pure colours' fit covers without the
+#: extension tests, and one it covers whole (``flag_wakes.comp``).
+FIT_PLAIN, FIT_WHOLE = 1, 2
+
+
+def pure_colour_mask(original_work, original, filtered, floor=0.0, gate=None, side=BLOCK_SIDE, margin=MARGIN):
+    """Which blocks the pure colours' fit covers, and where it needs its extension tests
+    (``flag_pure_colour_blocks`` and ``flag_wakes.comp``, GL 4.3).
 
     The fit with pure colours gives F exactly, with nothing for a Jacobi step to gather,
-    wherever F is flat around a pixel and none of its neighbours is a thin feature's partial
-    colour: its edge strength is O's gradient times the larger of F's and of the contrast of
-    the two extremes' filtered colours, which differ only where F varies or an extreme was
-    extended, and only a ridge is extended. So of O's active blocks (:func:`active_mask`) it
-    needs those within `margin` of a pixel that could be a ridge
+    wherever F is flat around a pixel and none of its extremes is extended: its edge strength
+    is O's gradient times the larger of F's and of the contrast of the two extremes' filtered
+    colours, which differ only where F varies or an extreme was extended; and only a ridge is
+    extended, by a pixel whose gate of drawn content is open. So of O's active blocks
+    (:func:`active_mask`) it needs those within `margin` of a pixel that could be a ridge
     (``aarecovery.spec.pure_colours.possible_ridges``) or that differs from a 4-neighbour in
     F; the margin of 2 holds the extreme (1 pixel) and what a step gathers from it (1 more).
-    A pixel of F that varies beside O's edges lies in O's active blocks, so only those pixels
-    are looked at.
+    Only those near a possible ridge, and with `gate` open on one of their own pixels, can
+    extend an extreme: the others take the same model without the tests. A pixel of F that
+    varies beside O's edges lies in O's active blocks, so only those pixels are looked at.
 
     Parameters
     ----------
@@ -132,17 +142,28 @@ def pure_colour_mask(original_work, original, filtered, floor=0.0, side=BLOCK_SI
         O and F as uploaded.
     floor : float
         The ridge's noise margin (``possible_ridges``).
+    gate : ndarray of float32, shape (H, W), optional
+        The local plan's gate of drawn content (``PureColourPrior.drawn_only``); None: open.
     side, margin : int
 
     Returns
     -------
-    ndarray of bool, shape (ceil(H / side), ceil(W / side))
+    ndarray of uint8, shape (ceil(H / side), ceil(W / side))
+        0 (not fitted), :data:`FIT_PLAIN` or :data:`FIT_WHOLE`.
     """
     height, width = original_work.shape[:2]
     fitted = active_mask(original, side, margin)
     inside = np.kron(fitted, np.ones((side, side), bool))[:height, :width]
-    wakes = possible_ridges(neighbours(planes(original_work)), floor) | differing_pixels(filtered)
-    return fitted & blocks_near(wakes & inside, side, margin)
+    ridges = possible_ridges(neighbours(planes(original_work)), floor) & inside
+    near_any = blocks_near(ridges | (differing_pixels(filtered) & inside), side, margin)
+    whole = blocks_near(ridges, side, margin)
+    if gate is not None:
+        rows, columns = fitted.shape
+        open_pixels = np.zeros((rows * side, columns * side), bool)
+        open_pixels[:height, :width] = np.asarray(gate) > 0
+        whole &= open_pixels.reshape(rows, side, columns, side).any(axis=(1, 3))
+    codes = np.where(whole, FIT_WHOLE, np.where(near_any, FIT_PLAIN, 0)).astype(np.uint8)
+    return np.where(fitted, codes, 0).astype(np.uint8)
 
 
 def extreme_offsets(code):

@@ -17,7 +17,7 @@ import struct
 import moderngl
 import numpy as np
 
-from .blocks import BLOCK_SIDE, DISPATCH_COMMAND_WORDS, DRAW_COMMAND_WORDS, LISTS, block_lists
+from .blocks import BLOCK_SIDE, DISPATCH_COMMAND_WORDS, DRAW_COMMAND_WORDS, FIT_PLAIN, FIT_WHOLE, LISTS, block_lists
 from .glsl import load_source
 
 __all__ = ["BlockClassifier", "BlockLists", "MAX_GROUPS", "block_grid"]
@@ -55,6 +55,8 @@ FULL_SCREEN_SHARE = 0.9
 _COMMANDS, _FLAGS, _FIRST_LIST = 1, 2, 3
 # O's block flags, read while the pure colours' blocks are flagged (flag_wakes.comp).
 _ORIGINAL_FLAGS = 7
+# The compaction's selection of any flag.
+_ANY_BITS = 0xFFFFFFFF
 
 
 def block_grid(size):
@@ -141,11 +143,11 @@ class BlockClassifier:
         #: Work groups per row of a dispatch; lists longer than this dispatch several rows.
         self.max_groups = MAX_GROUPS
 
-    def _compute_shader(self, name):
-        key = (name, self.max_groups, self.runs)
+    def _compute_shader(self, name, defines=None):
+        defines = {"MAX_GROUPS": self.max_groups, "RUNS": int(self.runs), **(defines or {})}
+        key = (name, tuple(sorted(defines.items())))
         if key not in self._programs:
-            self._programs[key] = self.context.compute_shader(
-                load_source(name, {"MAX_GROUPS": self.max_groups, "RUNS": int(self.runs)}))
+            self._programs[key] = self.context.compute_shader(load_source(name, defines))
         return self._programs[key]
 
     def classify(self, texture, lists):
@@ -193,35 +195,48 @@ class BlockClassifier:
         self._bind(lists, flags)
         self._compact(lists)
 
-    def list_near_wakes(self, wakes, original_lists, lists):
-        """Fill `lists` with the blocks of O's active ones (`original_lists`, classified on the
-        GPU) that hold a pixel of `wakes` or lie within the margin of one in another of O's
-        active blocks (``flag_wakes.comp``; twin ``blocks.pure_colour_mask``).
+    def list_near_wakes(self, wakes, original_lists, lists, split, gate=None):
+        """Fill `lists` with O's active blocks (`original_lists`, classified on the GPU) that
+        hold a pixel of `wakes` or lie within the margin of one in another of O's active
+        blocks (``flag_wakes.comp``; twin ``blocks.pure_colour_mask``), and `split`, a pair of
+        lists, with those of them where a ridge could be extended (a ridge's wake that near,
+        and with `gate` the gate open on one of the block's pixels) and the others.
 
         Parameters
         ----------
         wakes : moderngl.Texture
-            Non-zero where a pixel wakes the blocks around it, written over O's active blocks.
+            The wake bits (over 255) of each pixel of O's active blocks.
         original_lists, lists : BlockLists
+        split : tuple of two BlockLists
+        gate : moderngl.Texture, optional
+            The local plan's factor, its gate of drawn content in the second channel.
         """
         # The marks of a compute pass are fetched here; a fragment pass's need no barrier.
         self.context.memory_barrier(moderngl.TEXTURE_FETCH_BARRIER_BIT)
         self._bind(lists, lists.flags)
         original_lists.flags.bind_to_storage_buffer(_ORIGINAL_FLAGS)
         wakes.use(0)
-        flag = self._compute_shader("flag_wakes.comp")
+        flag = self._compute_shader("flag_wakes.comp", {"PURE_GATE": int(gate is not None)})
         flag["wakes"] = 0
+        if gate is not None:
+            gate.use(1)
+            flag["strength_factor"] = 1
         flag["image_size"] = wakes.size
         flag["block_grid"] = lists.grid
         flag.run(-(-lists.grid[0] * lists.grid[1] // 64))
         self._compact(lists)
+        for part, want in zip(split, (FIT_WHOLE, FIT_PLAIN)):
+            self._bind(part, lists.flags)
+            self._compact(part, want)
 
-    def _compact(self, lists):
-        """Steps 2 and 3 on the flags bound: the lists and their commands."""
+    def _compact(self, lists, want=None):
+        """Steps 2 and 3 on the flags bound: the lists and their commands, of the blocks whose
+        flags hold a bit of `want` (any)."""
         self.context.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
         columns, rows = lists.grid
         compact = self._compute_shader("compact_blocks.comp")
         compact["block_grid"] = lists.grid
+        compact["want_bits"] = _ANY_BITS if want is None else want
         compact.run(-(-columns * rows // 64))
         self.context.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
         self._compute_shader("finish_block_lists.comp").run(1)

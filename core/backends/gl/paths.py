@@ -128,7 +128,8 @@ class FragmentPath(_Path):
             self._programs[key] = (program, full_screen)
         return self._programs[key]
 
-    def run_pass(self, shader, inputs, outputs, *, blocks=None, list_name=None, uniforms=None, defines=None):
+    def run_pass(self, shader, inputs, outputs, *, blocks=None, list_name=None, uniforms=None, defines=None,
+                 only_listed=False):
         """Run pass `shader` over the whole image, or over the blocks of list `list_name`.
 
         Parameters
@@ -143,8 +144,12 @@ class FragmentPath(_Path):
         list_name : str, optional
             One of ``blocks.LISTS``, with `blocks`.
         uniforms, defines : dict, optional
+        only_listed : bool
+            Draw the list's blocks even where they are nearly all of them: the pass must not
+            write the others (a list that another pass with other defines covers the rest of).
         """
-        if blocks is not None and self._full_screen_when_nearly_everything and blocks.nearly_everything(list_name):
+        if (blocks is not None and not only_listed and self._full_screen_when_nearly_everything
+                and blocks.nearly_everything(list_name)):
             blocks = None
         program, full_screen = self._program(shader, "fullscreen.vert" if blocks is None else "blocks.vert",
                                              defines or {})
@@ -183,8 +188,10 @@ class ComputePath(_Path):
             self._programs[key] = self.context.compute_shader(load_source(f"{shader}.comp", defines))
         return self._programs[key]
 
-    def run_pass(self, shader, inputs, outputs, *, blocks=None, list_name=None, uniforms=None, defines=None):
-        """As :meth:`FragmentPath.run_pass`; outputs are bound as images 0, 1, ..."""
+    def run_pass(self, shader, inputs, outputs, *, blocks=None, list_name=None, uniforms=None, defines=None,
+                 only_listed=False):
+        """As :meth:`FragmentPath.run_pass`; outputs are bound as images 0, 1, ... (a list is
+        always dispatched block by block)."""
         program = self._program(shader, {**(defines or {}), "BLOCK_LIST": int(blocks is not None)})
         self._prepare(program, inputs, uniforms or {})
         for binding, texture in enumerate(outputs):

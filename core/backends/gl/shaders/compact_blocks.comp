@@ -21,8 +21,12 @@ bool inside(ivec2 block) {
     return all(greaterThanEqual(block, ivec2(0))) && all(lessThan(block, block_grid));
 }
 
+// A block is flagged when its flags hold a bit of want_bits (every classification but the
+// pure colours' split of their blocks wants any).
+uniform uint want_bits;
+
 bool flagged(ivec2 block) {
-    return inside(block) && block_flags[block.y * block_grid.x + block.x] != 0u;
+    return inside(block) && (block_flags[block.y * block_grid.x + block.x] & want_bits) != 0u;
 }
 
 bool member(int list, ivec2 block) {

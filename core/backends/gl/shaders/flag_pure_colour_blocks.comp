@@ -9,5 +9,5 @@ layout(r8, binding = 0) uniform writeonly image2D wakes;
 void main() {
     ivec2 p = block_origin() + ivec2(gl_LocalInvocationID.xy);
     if (!inside_image(p)) return;
-    imageStore(wakes, p, vec4(float(wakes_pure_colours(p, image_size))));
+    imageStore(wakes, p, vec4(float(pure_colour_wakes(p, image_size)) / 255.0));
 }

@@ -1,12 +1,21 @@
 #version 430
-// The pure colours' blocks (twin: pure_colour_mask in backends/gl/blocks.py): each of O's
-// active blocks whose pixels, or those within MARGIN of its sides in O's active blocks,
-// hold a wake (flag_pure_colour_blocks.frag, which wrote every pixel of O's active blocks
-// and nothing elsewhere that is read here). One invocation per block; the scan ends at the
-// first wake, so a block with edges of F costs a few fetches and one without 400.
+// The pure colours' blocks (twin: pure_colour_mask in backends/gl/blocks.py): of O's active
+// blocks, FIT_WHOLE those with a ridge's wake (pure_colour_blocks.glsl) on their pixels or
+// within MARGIN of their sides in O's active blocks, and with PURE_GATE the gate of drawn
+// content open on one of their own pixels; FIT_PLAIN the others with any wake that near
+// (flag_pure_colour_blocks.frag wrote every pixel of O's active blocks; elsewhere the
+// texture holds what an earlier pass left). One invocation per block; the scan ends at the
+// first ridge's wake, so a block with thin features costs a few fetches and one without 400.
 layout(local_size_x = 64) in;
 
+#ifndef PURE_GATE
+#define PURE_GATE 0
+#endif
+
 uniform sampler2D wakes;
+#if PURE_GATE
+uniform sampler2D strength_factor;  // the local plan's regions' weight in .g (local_plan.glsl)
+#endif
 uniform ivec2 image_size;
 uniform ivec2 block_grid;  // blocks across and down
 layout(std430, binding = 2) writeonly buffer BlockFlags { uint block_flags[]; };
@@ -14,6 +23,9 @@ layout(std430, binding = 7) readonly buffer OriginalFlags { uint original_flags[
 
 const int BLOCK_SIDE = 16;
 const int MARGIN = 2;
+const uint WAKE_RIDGE = 2u;  // pure_colour_blocks.glsl
+const uint FIT_PLAIN = 1u;
+const uint FIT_WHOLE = 2u;
 
 bool original_active(ivec2 block) {
     return all(greaterThanEqual(block, ivec2(0))) && all(lessThan(block, block_grid))
@@ -24,24 +36,35 @@ void main() {
     int index = int(gl_GlobalInvocationID.x);
     if (index >= block_grid.x * block_grid.y) return;
     ivec2 block = ivec2(index % block_grid.x, index / block_grid.x);
-    // O's active blocks among this one and its 8 neighbours, bit (dy + 1) * 3 + dx + 1:
-    // a wake counts only in those (elsewhere the texture holds what an earlier pass left).
+    // O's active blocks among this one and its 8 neighbours, bit (dy + 1) * 3 + dx + 1.
     uint around = 0u;
     for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx)
             if (original_active(block + ivec2(dx, dy))) around |= 1u << uint((dy + 1) * 3 + dx + 1);
-    bool found = false;
+    uint found = 0u;
     if ((around & 16u) != 0u) {
         ivec2 low = max(block * BLOCK_SIDE - MARGIN, ivec2(0));
         ivec2 high = min(block * BLOCK_SIDE + BLOCK_SIDE - 1 + MARGIN, image_size - 1);
         int across = high.x - low.x + 1;
         int count = across * (high.y - low.y + 1);
-        // One loop, left as soon as every lane of a group has found a wake.
-        for (int i = 0; i < count && !found; ++i) {
+        // One loop, left as soon as every lane of a group has found a ridge's wake.
+        for (int i = 0; i < count && (found & WAKE_RIDGE) == 0u; ++i) {
             ivec2 q = low + ivec2(i % across, i / across);
             ivec2 at = q / BLOCK_SIDE - block + 1;
-            found = ((around >> uint(at.y * 3 + at.x)) & 1u) != 0u && texelFetch(wakes, q, 0).r > 0.0;
+            if (((around >> uint(at.y * 3 + at.x)) & 1u) != 0u) found |= uint(texelFetch(wakes, q, 0).r * 255.0 + 0.5);
         }
     }
-    block_flags[index] = found ? 1u : 0u;
+    bool whole = (found & WAKE_RIDGE) != 0u;
+#if PURE_GATE
+    // Only a pixel whose gate is open extends its extremes.
+    ivec2 first = block * BLOCK_SIDE;
+    ivec2 last = min(first + BLOCK_SIDE - 1, image_size - 1);
+    int across_block = last.x - first.x + 1;
+    int pixels = whole ? across_block * (last.y - first.y + 1) : 0;
+    bool open = false;
+    for (int i = 0; i < pixels && !open; ++i)
+        open = texelFetch(strength_factor, first + ivec2(i % across_block, i / across_block), 0).g > 0.0;
+    whole = whole && open;
+#endif
+    block_flags[index] = whole ? FIT_WHOLE : (found != 0u ? FIT_PLAIN : 0u);
 }

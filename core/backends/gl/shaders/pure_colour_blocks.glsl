@@ -1,9 +1,12 @@
-// Which pixels wake the pure colours' fit around them: those that could be a thin feature's
-// ridge, or where F varies. The fit covers O's active blocks within 2 pixels of one
-// (flag_wakes.comp lists them); elsewhere it gives F exactly. Twin: pure_colour_mask in
-// backends/gl/blocks.py and possible_ridges in aarecovery/spec/pure_colours.py, which
-// derive the rule. Needs working.glsl first (O in the working space, F as uploaded).
-
+// Which pixels wake the pure colours' fit around them: where F varies (WAKE_FILTERED), and
+// that could be a thin feature's ridge (WAKE_RIDGE). The fit covers O's active blocks within
+// 2 pixels of a wake (flag_wakes.comp lists them), without the extension tests where no ridge
+// is that near or, gated, where the drawn content's gate is shut on the whole block;
+// elsewhere it gives F exactly. Twin: pure_colour_mask in backends/gl/blocks.py and
+// possible_ridges in aarecovery/spec/pure_colours.py, which derive the rule. Needs
+// working.glsl first (O in the working space, F as uploaded).
+const uint WAKE_FILTERED = 1u;
+const uint WAKE_RIDGE = 2u;
 uniform float ridge_floor;  // RIDGE_NOISE_MARGIN times O's ridge noise: 0 on a lossless O
 
 const float RIDGE_LINE_TOLERANCE = 0.05;  // pure_colours.glsl's LINE_TOLERANCE
@@ -42,6 +45,9 @@ bool filtered_varies(ivec2 p, ivec2 size) {
     return varies;
 }
 
-bool wakes_pure_colours(ivec2 p, ivec2 size) {
-    return filtered_varies(p, size) || possible_ridge(p, size);
+// The wake bits of pixel p (pure_colour_blocks.frag stores them as p's texel of wakes).
+uint pure_colour_wakes(ivec2 p, ivec2 size) {
+    uint wakes = filtered_varies(p, size) ? WAKE_FILTERED : 0u;
+    if (possible_ridge(p, size)) wakes |= WAKE_RIDGE;
+    return wakes;
 }

@@ -27,6 +27,11 @@ uniform float luma_purity;         // an extreme whose luma is within this of a 
 #ifndef PURE_GATE
 #define PURE_GATE 0
 #endif
+// NO_EXTENSION: 1: no extreme is extended (the blocks the pure colours' listing found no
+//            possible ridge near: backend._pure_colour_lists), the same model as where every test fails
+#ifndef NO_EXTENSION
+#define NO_EXTENSION 0
+#endif
 
 // The prior's switches are compile-time defines, not uniforms: llvmpipe runs both sides of
 // every branch under a mask, so a uniform switch paid for every key's sRGB conversions
@@ -116,6 +121,11 @@ struct Extension {
 // line from `near` to the colour cube (with PURE_GATE, `gate`'s share of the way).
 Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 size, float gate) {
     Extension result = Extension(false, far, far);
+#if NO_EXTENSION
+    // The blocks with no possible ridge near an open gate (pure_colour_blocks.glsl): none of
+    // the tests below passes there, and llvmpipe would run them all under a mask.
+    return result;
+#endif
 #if PURE_GATE
     // Shut (a photo region): never extended, as at the end of the tests below, without them.
     if (!(gate > 0.0)) return result;
