@@ -34,17 +34,6 @@ bool possible_ridge(ivec2 q, ivec2 size) {
         || possible_pair(v[0] - v[5], v[0] - v[8]) || possible_pair(v[0] - v[6], v[0] - v[7]);
 }
 
-// F as uploaded differs from a 4-neighbour at p (equal there is equal in the working space).
-bool filtered_varies(ivec2 p, ivec2 size) {
-    vec4 here = texelFetch(filtered_image, p, 0);
-    bool varies = false;
-    if (p.x > 0) varies = varies || any(notEqual(here, texelFetch(filtered_image, p - ivec2(1, 0), 0)));
-    if (p.x < size.x - 1) varies = varies || any(notEqual(here, texelFetch(filtered_image, p + ivec2(1, 0), 0)));
-    if (p.y > 0) varies = varies || any(notEqual(here, texelFetch(filtered_image, p - ivec2(0, 1), 0)));
-    if (p.y < size.y - 1) varies = varies || any(notEqual(here, texelFetch(filtered_image, p + ivec2(0, 1), 0)));
-    return varies;
-}
-
 // The wake bits of pixel p (pure_colour_blocks.frag stores them as p's texel of wakes).
 uint pure_colour_wakes(ivec2 p, ivec2 size) {
     uint wakes = filtered_varies(p, size) ? WAKE_FILTERED : 0u;

@@ -2,7 +2,8 @@
 // a straight sRGB-encoded result as far as the model did not act, where F is not flat; the
 // pass ramp_lookup.frag (.comp) over F's active blocks after the Jacobi steps. Twin: ramp_slopes,
 // ramp_delta and ramp_lookup in aarecovery/spec/ramp_lookup.py, which explains the rule and
-// its measurements. Needs working.glsl (colour, neighbourhood and F as uploaded, filtered_image);
+// its measurements; the lookup acts only where F varies (working.glsl's filtered_varies, the
+// twin's _varies). Needs working.glsl (colour, neighbourhood and F as uploaded, filtered_image);
 // O must be uploaded sRGB-encoded (the plan takes no ramp lookup for linear inputs).
 #include "transfer_table.glsl"
 
@@ -84,15 +85,6 @@ vec3 ramp_delta(ivec2 p, ivec2 size) {
     vec3 centre, along_x, along_y;
     if (!ramp_takes(p, size, centre, along_x, along_y)) return vec3(0.0);
     return ramp_average(centre, along_x, along_y);
-}
-
-// Whether F differs from one of the pixel's four neighbours (_varies): the lookup only there.
-bool filtered_varies(ivec2 p, ivec2 size) {
-    vec4 centre = texelFetch(filtered_image, p, 0);
-    return any(notEqual(texelFetch(filtered_image, clamp_to_image(p + ivec2(0, -1), size), 0), centre))
-        || any(notEqual(texelFetch(filtered_image, clamp_to_image(p + ivec2(-1, 0), size), 0), centre))
-        || any(notEqual(texelFetch(filtered_image, clamp_to_image(p + ivec2(1, 0), size), 0), centre))
-        || any(notEqual(texelFetch(filtered_image, clamp_to_image(p + ivec2(0, 1), size), 0), centre));
 }
 
 // A straight result with the ramp lookup's `delta` added by the model's confidence `beta`

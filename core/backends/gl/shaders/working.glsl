@@ -20,6 +20,16 @@ vec4 filtered_neighbour(ivec2 p, int i, ivec2 size) {
 }
 #endif
 
+// Whether F as uploaded differs from one of p's four neighbours (equal there is equal in the
+// working space): where the ramp lookup acts, and what wakes the pure colours' fit.
+bool filtered_varies(ivec2 p, ivec2 size) {
+    vec4 centre = texelFetch(filtered_image, p, 0);
+    return any(notEqual(texelFetch(filtered_image, clamp_to_image(p + ivec2(0, -1), size), 0), centre))
+        || any(notEqual(texelFetch(filtered_image, clamp_to_image(p + ivec2(-1, 0), size), 0), centre))
+        || any(notEqual(texelFetch(filtered_image, clamp_to_image(p + ivec2(1, 0), size), 0), centre))
+        || any(notEqual(texelFetch(filtered_image, clamp_to_image(p + ivec2(0, 1), size), 0), centre));
+}
+
 // A result's coverage at or below this is none (twin: VISIBLE_COVERAGE in working_space.py,
 // which says why).
 const float VISIBLE_COVERAGE = 0.5 / 65535.0;
