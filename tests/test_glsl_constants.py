@@ -13,7 +13,7 @@ from aarecovery.spec import blend_model, local_plan, pure_colours, ramp_lookup, 
 # (shader file, GLSL name) -> the value the NumPy specification uses.
 TWINS = {
     ("pure_colours.glsl", "PALETTE_TOLERANCE"): pure_colours.PALETTE_TOLERANCE,
-    ("pure_colours.glsl", "LINE_TOLERANCE"): pure_colours.LINE_TOLERANCE,
+    ("pure_colour_blocks.glsl", "LINE_TOLERANCE"): pure_colours.LINE_TOLERANCE,
     ("pure_colours.glsl", "RIDGE_MARGIN"): pure_colours.RIDGE_MARGIN,
     ("pure_colours.glsl", "RIDGE_NOISE_MARGIN"): pure_colours.RIDGE_NOISE_MARGIN,
     ("pure_colours.glsl", "EXPLAIN_TOLERANCE"): pure_colours.EXPLAIN_TOLERANCE,
@@ -62,7 +62,6 @@ TWINS = {
     ("classify_blocks.frag", "MARGIN"): blocks.MARGIN,
     ("classify_blocks.frag", "BLOCK_SIDE"): blocks.BLOCK_SIDE,
     ("live_blocks.glsl", "LIVE_BLOCK_SIDE"): blocks.BLOCK_SIDE,
-    ("pure_colour_blocks.glsl", "RIDGE_LINE_TOLERANCE"): pure_colours.LINE_TOLERANCE,
     ("pure_colour_blocks.glsl", "RIDGE_BOUND_SLACK"): pure_colours.RIDGE_BOUND_SLACK,
     ("flag_wakes.comp", "BLOCK_SIDE"): blocks.BLOCK_SIDE,
     ("flag_wakes.comp", "MARGIN"): blocks.MARGIN,

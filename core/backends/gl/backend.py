@@ -19,11 +19,11 @@ pure colours (whose edge strength does not need F's gradient); with pure colours
 GPU classification, pass 1 covers only those of O's blocks near a pixel that could be a thin
 feature's ridge or where F varies, where the plan asks for it (``pure_colour_blocks.glsl``),
 without the extension tests where no ridge could be extended, and pass 2 only the blocks
-where pass 1 found that a step can change anything (``live_blocks.glsl``). Pass 3 covers the other blocks. The block lists are made
-on the GPU when a run first needs them (``classify.py``) and drive the draws and
-dispatches indirectly. On llvmpipe, which shades every covered
-fragment, this is what makes mostly flat results (threshold, posterize) fast; on a GPU it
-saves the work of idle lanes.
+where pass 1 found that a step can change anything (``live_blocks.glsl``). Pass 3 covers the
+other blocks. The block lists are made on the GPU when a run first needs them
+(``classify.py``) and drive the draws and dispatches indirectly. On llvmpipe, which shades
+every covered fragment, this is what makes mostly flat results (threshold, posterize) fast;
+on a GPU it saves the work of idle lanes.
 
 Each pass runs as a fragment pass or as a compute pass (``paths.py``), chosen by capability
 and a measured rule, or by the caller (``gl_path``).

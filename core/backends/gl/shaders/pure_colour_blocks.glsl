@@ -9,13 +9,15 @@ const uint WAKE_FILTERED = 1u;
 const uint WAKE_RIDGE = 2u;
 uniform float ridge_floor;  // RIDGE_NOISE_MARGIN times O's ridge noise: 0 on a lossless O
 
-const float RIDGE_LINE_TOLERANCE = 0.05;  // pure_colours.glsl's LINE_TOLERANCE
+// Neighbours count for the ridge test within this distance of the extremes' line (the twin's
+// LINE_TOLERANCE; pure_colours.glsl includes this file for it).
+const float LINE_TOLERANCE = 0.05;
 const float RIDGE_BOUND_SLACK = 1e-4;
 
 // Opposite neighbours at a and b from the centre (the differences centre - neighbour) can
 // both lie near the extremes' line and below the centre along it.
 bool possible_pair(vec4 a, vec4 b) {
-    float line_sq = RIDGE_LINE_TOLERANCE * RIDGE_LINE_TOLERANCE + RIDGE_BOUND_SLACK;
+    float line_sq = LINE_TOLERANCE * LINE_TOLERANCE + RIDGE_BOUND_SLACK;
     float a_sq = dot(a, a);
     float b_sq = dot(b, b);
     float along = sqrt(max(a_sq - line_sq, 0.0)) * sqrt(max(b_sq - line_sq, 0.0));

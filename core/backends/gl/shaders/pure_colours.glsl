@@ -2,6 +2,8 @@
 // Twin: extend_extreme and filtered_colour in aarecovery/spec/pure_colours.py, which explains
 // the rule and its measurements. Included after working.glsl, before blend_model.glsl.
 #include "transfer_table.glsl"
+// The ridge test's LINE_TOLERANCE, shared with the blocks it marks:
+#include "pure_colour_blocks.glsl"
 
 uniform vec3 palette[32];          // O's flat colours, opaque, in the working space
 uniform int palette_size;
@@ -52,7 +54,6 @@ uniform float luma_purity;         // an extreme whose luma is within this of a 
 #endif
 
 const float PALETTE_TOLERANCE = 0.03;
-const float LINE_TOLERANCE = 0.05;
 const float RIDGE_MARGIN = 0.1001;
 const float RIDGE_NOISE_MARGIN = 1.5;
 const float EXPLAIN_TOLERANCE = 0.02;
