@@ -165,12 +165,19 @@ def test_flat_pixels_by_running_extremes_are_the_stacked_ones(seed):
 
 
 @pytest.mark.parametrize("seed", range(4))
-def test_the_local_factor_at_some_pixels_is_the_whole_factor_there(seed):
+@pytest.mark.parametrize("share", [0.1, 0.2, 0.4, 0.8])
+def test_the_local_factor_at_some_pixels_is_the_whole_factor_there(seed, share):
+    """Both ways of reading the ink at some pixels (their neighbourhoods gathered, or the
+    whole image's weight above local_plan._GATHERED_SHARE of its pixels) give its values, at
+    the 8-bit span and at a JPEG's."""
+    from aarecovery.plan.mixed_content import COMPRESSED_INK_SPAN
     from aarecovery.spec.local_plan import LocalStrength, ink_weight, ink_weight_at
     image = _drawn_and_noisy(seed)
-    rows, cols = np.nonzero(np.random.default_rng(seed).random(image.shape[:2]) < 0.4)
+    rows, cols = np.nonzero(np.random.default_rng(seed).random(image.shape[:2]) < share)
     assert ink_weight(image)[rows, cols].any()
     np.testing.assert_array_equal(ink_weight_at(image, rows, cols), ink_weight(image)[rows, cols])
+    np.testing.assert_array_equal(ink_weight_at(image, rows, cols, COMPRESSED_INK_SPAN),
+                                  ink_weight(image, span=COMPRESSED_INK_SPAN)[rows, cols])
     for local in (LocalStrength(0.25), LocalStrength(0.5, drawn_ink=False)):
         np.testing.assert_array_equal(local.factor_at(image, rows, cols), local.factor(image)[rows, cols])
 
@@ -366,3 +373,4 @@ def test_the_grain_by_running_sums_and_extremes_is_that_of_the_stacked_views(see
               & (largest_channel(high_spread) > texture._GRAIN_HIGH_PASS))
     assert quiet.sum() >= texture._MIN_QUIET and 0 < grainy[quiet].mean() < 1
     assert texture.grain(image) == float(grainy[quiet].mean())
+

@@ -223,6 +223,13 @@ def ink_weight(encoded, shares=(INK_SHARE_LOW, INK_SHARE_HIGH), repeats=INK_REPE
     return _ink_weight(planes, extremes, _recurrences(planes, extremes, span), shares, repeats)
 
 
+# Above this share of the image's pixels, ink_weight_at reads the whole image's weight at
+# them (the same values): gathering each pixel's neighbourhood costs about three times as
+# much per pixel (512 x 512 window, text over a photo at 0.81 of it: 0.35 s against 0.16 s;
+# at 0.04, a photo's edges, 0.02 s against 0.20 s).
+_GATHERED_SHARE = 0.3
+
+
 def ink_weight_at(encoded, rows, cols, span=FLAT_SPAN):
     """float32 ``(K,)``: :func:`ink_weight` at the pixels ``(rows[k], cols[k])`` only, the
     same values, reading only their neighbourhoods (the summary line reads it at a
@@ -239,6 +246,8 @@ def ink_weight_at(encoded, rows, cols, span=FLAT_SPAN):
     """
     encoded = np.asarray(encoded, np.float32)
     rows, cols = np.asarray(rows, np.intp), np.asarray(cols, np.intp)
+    if rows.size > _GATHERED_SHARE * encoded.shape[0] * encoded.shape[1]:
+        return ink_weight(encoded, span=span)[rows, cols]
     replicated = np.pad(encoded, ((1, 1), (1, 1), (0, 0)), mode="edge")
     # Row by row, as _extremes visits them.
     extremes = _pick_extremes(np.ascontiguousarray(replicated[rows + dy, cols + dx].T)
