@@ -119,7 +119,8 @@ def count_changed_pixels(filtered, recovered):
                for top in range(0, height, _STRIP_ROWS))
 
 
-def summarize_recovery(plan, original, filtered, recovered, linear=False, *, changed_pixels=None):
+def summarize_recovery(plan, original, filtered, recovered, linear=False, *, changed_pixels=None,
+                       original_window=None):
     """Summarize a recovery of `original` and `filtered` into `recovered` under `plan`.
 
     Parameters
@@ -129,11 +130,14 @@ def summarize_recovery(plan, original, filtered, recovered, linear=False, *, cha
         engine it is given).
     original, filtered, recovered : ndarray
         As given to and returned by :func:`aarecovery.recover`; `recovered` has the shape
-        and dtype of `filtered`.
+        and dtype of `filtered`. `original` may be None with `original_window`.
     linear : bool
         The images hold linear-light values (as given to ``recover``).
     changed_pixels : int, optional
         :func:`count_changed_pixels` of the pair when already counted.
+    original_window : ndarray, optional
+        ``original[plan.window]``, the only part of O the summary reads, when the caller kept
+        that and freed the rest (the command line does, before it encodes the result).
 
     Returns
     -------
@@ -143,8 +147,10 @@ def summarize_recovery(plan, original, filtered, recovered, linear=False, *, cha
     if changed_pixels is None:
         changed_pixels = count_changed_pixels(filtered, recovered)
     # The window the plan analysed, when it says (choosing it again costs 50 ms at 4096^2).
+    if original_window is not None and plan.window is None:
+        raise ValueError("original_window needs the plan's window (Plan.window): give the whole original instead")
     window = plan.window or analysis_window(lambda rows, cols: original[rows, cols], f_layout.height, f_layout.width)
-    o_window = original[window]
+    o_window = original[window] if original_window is None else original_window
     o_rgba = to_rgba_float(o_window, layout_of(o_window, "original"), "original")
     edges = gradient_magnitude(o_rgba[..., :3]) >= EDGE_GRADIENT
     share = float(_changed(filtered[window], recovered[window])[edges].mean()) if edges.any() else 0.0

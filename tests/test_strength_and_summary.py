@@ -216,3 +216,34 @@ def test_the_summary_reads_the_window_the_plan_analysed(backend):
     assert summary.line() == chosen_again.line()
     assert (summary.changed_pixels, summary.edge_share) == (chosen_again.changed_pixels, chosen_again.edge_share)
     assert summary.changed_pixels > 0 and summary.edge_share > 0.05
+
+
+def test_the_summary_from_the_window_of_o_alone_is_the_whole_ones(backend):
+    """The command line keeps only O's analysis window for the summary and frees the rest
+    before it encodes R (its peak memory was there): the same summary."""
+    original, filtered = (np.zeros((700, 900, 3), np.uint8) for _ in range(2))
+    original[560:, 700:], filtered[560:, 700:] = edge_pair(140, 200, np.uint8)
+    original[40:180, 60:260], filtered[40:180, 60:260] = edge_pair(140, 200, np.uint8)
+    with aarecovery.Engine(backend) as engine:
+        recovered = aarecovery.recover(original, filtered, engine=engine)
+    plan = engine.last_plan
+    whole = aarecovery.summarize_recovery(plan, original, filtered, recovered)
+    windowed = aarecovery.summarize_recovery(plan, None, filtered, recovered, original_window=original[plan.window])
+    assert windowed == whole and whole.edge_share > 0.05
+    with pytest.raises(ValueError, match="needs the plan's window"):
+        aarecovery.summarize_recovery(dataclasses.replace(plan, window=None), None, filtered, recovered,
+                                      original_window=original[plan.window])
+
+
+def test_the_command_line_summary_is_the_apis(tmp_path, capsys):
+    original, filtered = (np.zeros((700, 900, 3), np.uint8) for _ in range(2))
+    original[560:, 700:], filtered[560:, 700:] = edge_pair(140, 200, np.uint8)
+    aarecovery.write_image(tmp_path / "o.png", original)
+    aarecovery.write_image(tmp_path / "f.png", filtered)
+    assert main(["recover", str(tmp_path / "o.png"), str(tmp_path / "f.png"), "-o", str(tmp_path / "r.png"),
+                 "--backend", "numpy"]) == 0
+    printed = capsys.readouterr().out.splitlines()[-1]
+    with aarecovery.Engine("numpy") as engine:
+        recovered = aarecovery.recover(original, filtered, engine=engine)
+        expected = aarecovery.summarize_recovery(engine.last_plan, original, filtered, recovered)
+    assert printed == expected.line(force="--strength 1")

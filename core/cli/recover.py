@@ -171,12 +171,14 @@ def run(args):
 
 def _recover_files(args, params, pool):
     """The pair read, recovered and written, with `pool`'s two threads for the files."""
+    import dataclasses
     import time
 
     from ..engine import Engine
     from ..io import check_output_path, write_images
     from ..outcome import count_changed_pixels
     from ..pipeline import recover
+    from ..sample import array_window
 
     # A pair read whole decodes while the engine makes its GL context; when it cannot (no
     # OpenGL), the error comes without waiting for the decoding.
@@ -190,6 +192,7 @@ def _recover_files(args, params, pool):
                     print(printable(line))
             return 0
         original, filtered = _finish_reading(reads or _start_reading(pool, args), args)
+        reads = None  # the futures hold the decoded pair too
         # Before the recovery, so that a long run does not end in a refusal.
         check_output_path(args.output, filtered.shape)
         start = time.perf_counter()
@@ -206,6 +209,12 @@ def _recover_files(args, params, pool):
     maps = None
     if args.maps is not None:
         result, maps = result
+    # The summary reads O only in the window the plan analysed (chosen here for --paper, as
+    # the summary would): that crop is kept and the rest freed before the encoder makes its
+    # buffer of filtered rows, where the process peaked (docs/performance.md).
+    if plan.window is None:
+        plan = dataclasses.replace(plan, window=array_window(original))
+    original_window, original = original[plan.window].copy(), None
     images = {args.output: result}
     if maps is not None:
         os.makedirs(args.maps, exist_ok=True)
@@ -220,16 +229,19 @@ def _recover_files(args, params, pool):
     if args.maps is not None:
         message += f"; maps in {args.maps}"
     print(printable(message))
-    print(summary_line(plan, original, filtered, result, linear=args.linear, changed_pixels=counting.result()))
+    print(summary_line(plan, original, filtered, result, linear=args.linear, changed_pixels=counting.result(),
+                       original_window=original_window))
     return 0
 
 
-def summary_line(plan, original=None, filtered=None, recovered=None, linear=False, changed_pixels=None):
+def summary_line(plan, original=None, filtered=None, recovered=None, linear=False, changed_pixels=None,
+                 original_window=None):
     """What the recovery did, in the command line's words (the plan alone for a streamed pair)."""
     from ..outcome import RecoverySummary, summarize_recovery
 
     summary = (RecoverySummary(plan, None, None) if recovered is None
-               else summarize_recovery(plan, original, filtered, recovered, linear, changed_pixels=changed_pixels))
+               else summarize_recovery(plan, original, filtered, recovered, linear, changed_pixels=changed_pixels,
+                                       original_window=original_window))
     return summary.line(force="--strength 1")
 
 
