@@ -143,12 +143,12 @@ def summarize_recovery(plan, original, filtered, recovered, linear=False, *, cha
     -------
     RecoverySummary
     """
+    if original_window is not None and plan.window is None:
+        raise ValueError("original_window needs the plan's window (Plan.window): give the whole original instead")
     f_layout = layout_of(filtered, "filtered")
     if changed_pixels is None:
         changed_pixels = count_changed_pixels(filtered, recovered)
     # The window the plan analysed, when it says (choosing it again costs 50 ms at 4096^2).
-    if original_window is not None and plan.window is None:
-        raise ValueError("original_window needs the plan's window (Plan.window): give the whole original instead")
     window = plan.window or analysis_window(lambda rows, cols: original[rows, cols], f_layout.height, f_layout.width)
     o_window = original[window] if original_window is None else original_window
     o_rgba = to_rgba_float(o_window, layout_of(o_window, "original"), "original")

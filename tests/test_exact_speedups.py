@@ -373,4 +373,3 @@ def test_the_grain_by_running_sums_and_extremes_is_that_of_the_stacked_views(see
               & (largest_channel(high_spread) > texture._GRAIN_HIGH_PASS))
     assert quiet.sum() >= texture._MIN_QUIET and 0 < grainy[quiet].mean() < 1
     assert texture.grain(image) == float(grainy[quiet].mean())
-
