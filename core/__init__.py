@@ -14,17 +14,35 @@ in ``docs/architecture.md``.
 
 __version__ = "0.1.0"
 
-from . import filters
-from .backends.base import Decision, Plan, RecoveryMaps
-from .backends import GLUnavailable
-from .batch import recover_many
-from .engine import Engine
-from .errors import InputError, OrderWarning, OrientationWarning
-from .io import read_image, read_quantization, write_image
-from .outcome import RecoverySummary, summarize_recovery
-from .params import BACKENDS, BLEND_SPACES, GL_PATHS, MODES, PARAMETERS
-from .pipeline import recover
-from .plan.order import check_order
+import importlib
+
+# The public names are imported where first used (PEP 562, as scikit-image's are), so that a
+# command imports what it runs: `import aarecovery` took 0.19 s when it imported the batch
+# engine, the filters' catalogue and every subpackage behind them.
+_PUBLIC = {
+    "recover": "pipeline", "recover_many": "batch", "check_order": "plan.order",
+    "summarize_recovery": "outcome", "RecoverySummary": "outcome", "Engine": "engine",
+    "Plan": "backends.base", "Decision": "backends.base", "RecoveryMaps": "backends.base",
+    "GLUnavailable": "backends", "InputError": "errors", "OrderWarning": "errors",
+    "OrientationWarning": "errors", "read_image": "io", "read_quantization": "io", "write_image": "io",
+    "PARAMETERS": "params", "BACKENDS": "params", "GL_PATHS": "params", "MODES": "params",
+    "BLEND_SPACES": "params", "filters": None,  # None: the subpackage itself
+}
+
+
+def __getattr__(name):
+    if name not in _PUBLIC:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    module = _PUBLIC[name]
+    value = (importlib.import_module(f".{name}", __name__) if module is None
+             else getattr(importlib.import_module(f".{module}", __name__), name))
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
+
 
 __all__ = ["recover", "recover_many", "check_order", "summarize_recovery", "Engine", "Plan", "Decision", "RecoveryMaps",
            "RecoverySummary", "InputError", "GLUnavailable", "OrderWarning", "OrientationWarning", "read_image",

@@ -42,3 +42,28 @@ def test_import_contracts_are_kept(tmp_path):
                              env={**os.environ, "PYTHONPATH": str(site)}, capture_output=True, text=True)
     assert checked.returncode == 0, checked.stdout[-4000:] + checked.stderr[-2000:]
     assert "4 kept, 0 broken" in checked.stdout, checked.stdout[-2000:]
+
+
+def test_the_public_api_is_imported_where_first_used():
+    # `import aarecovery` imports no subpackage; each public name imports its module when
+    # first read, and is that module's own object.
+    code = (
+        "import importlib, sys, aarecovery\n"
+        "print(sorted(m for m in sys.modules if m.startswith('aarecovery.')))\n"
+        "from aarecovery import *\n"
+        "print(sorted(set(aarecovery.__all__) - set(dir(aarecovery))))\n"
+        "for name, module in aarecovery._PUBLIC.items():\n"
+        "    own = importlib.import_module('aarecovery.' + (module or name))\n"
+        "    assert getattr(aarecovery, name) is (own if module is None else getattr(own, name)), name\n"
+        "try:\n"
+        "    aarecovery.recovr\n"
+        "except AttributeError as error:\n"
+        "    print(error)\n")
+    lines = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.splitlines()
+    assert lines == ["[]", "[]", "module 'aarecovery' has no attribute 'recovr'"]
+
+
+def test_every_public_name_is_listed_once():
+    import aarecovery
+
+    assert sorted(aarecovery._PUBLIC) == sorted(set(aarecovery.__all__) - {"__version__"})

@@ -507,12 +507,13 @@ def test_a_codec_that_cannot_load_for_lack_of_memory_is_not_called_a_broken_file
     # that as "could not import name 'png_decode'", which read as a corrupt file before.
     write_image(tmp_path / "small.png", np.zeros((8, 8, 3), np.uint8))
     script = (
-        "import resource, sys, aarecovery\n"
+        "import resource, sys\n"
         "import imagecodecs\n"
+        "from aarecovery import read_image\n"
         "size = int(open('/proc/self/statm').read().split()[0]) * resource.getpagesize()\n"
         "resource.setrlimit(resource.RLIMIT_AS, (size, resource.RLIM_INFINITY))\n"
         "try:\n"
-        "    aarecovery.read_image(sys.argv[1])\n"
+        "    read_image(sys.argv[1])\n"
         "except BaseException as error:\n"
         "    print(type(error).__name__, error)\n")
     result = subprocess.run([sys.executable, "-c", script, str(tmp_path / "small.png")], capture_output=True,
