@@ -35,6 +35,9 @@ def _cases():
     """Thin strokes and filled shapes under a threshold, in the layouts the passes read O from."""
     original, filtered = _thin_pair()
     yield "rgb8", original, filtered
+    # Odd sides: the blocks' scan of the wakes reads 2 x 2 texels at a time, the last row and
+    # column of the image clamped (flag_wakes.comp).
+    yield "rgb8-odd", *_thin_pair(height=81, width=97, seed=5)
     yield "rgb-float", (original / 255).astype(np.float32), (filtered / 255).astype(np.float32)
     alpha = np.full(original.shape[:2] + (1,), 255, np.uint8)
     alpha[:, original.shape[1] // 2:] = 160  # half the layer translucent
