@@ -48,7 +48,10 @@ def _receive(stream):
 def serve(requests=None, replies=None):
     """Answer ``(original, filtered, parameters, options)`` requests with ``make_plan``'s plan until EOF."""
     from ..plan import make_plan
+    from ..plan.ahead import plan_in_order
 
+    # The processes are the parallelism: each plan in one thread (plan/ahead.py).
+    plan_in_order()
     # Ctrl+C reaches every process of the terminal's group; the batch decides what stops.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     requests = requests or sys.stdin.buffer

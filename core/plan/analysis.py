@@ -80,6 +80,7 @@ from ..contract import layout_of, to_rgba_float
 from ..params import ITERATIONS, SIGMA_D, SIGMA_E
 from ..spec.local_plan import FLAT_SPAN, LocalStrength
 from ..spec.sobel import gradient_magnitude
+from .ahead import InOrder, analyses_ahead
 from .blend_space import choose_blend_space, means_tell_srgb
 from .calibration import EDGE_GRADIENT, calibrate_strength
 from .colour_map import COLOUR_MAP_SHARE, HARD_EDGED_COLOUR_MAP_SHARE, fit_colour_map
@@ -280,8 +281,9 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
         Its ``decision`` names the exit taken; the module's docstring lists them in order.
     """
     readings = []
-    analysis = _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterations, quantization,
-                       readings)
+    with analyses_ahead() as ahead:
+        analysis = _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterations, quantization,
+                           readings, ahead)
     # The best pair of neighbours (spec.blend_model.best_pair) on a lossless O only: a JPEG's
     # noise is a third colour in every neighbourhood, which the nearest pair explains. Tuning
     # half, the JPEG twins with it: 112 cases down, 80 up (the compressed drawings 0.531 ->
@@ -298,22 +300,26 @@ def analyse(original_rgba, filtered_rgba, *, linear_input=False, sigma_d=SIGMA_D
                    pure_colour_blocks=listed)
 
 
-def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterations, quantization, readings):
-    """:func:`analyse`'s decisions; appends each compression reading of O it takes to `readings`."""
+def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterations, quantization, readings, ahead):
+    """:func:`analyse`'s decisions; appends each compression reading of O it takes to `readings`;
+    `ahead` runs the analyses that need nothing decided before them (``plan/ahead.py``)."""
     o_rgba = analysis_crop(original_rgba)
     f_rgba = analysis_crop(filtered_rgba)
     # The remaining analysis is on sRGB-encoded colour, as filters see it.
     o = o_rgba[..., :3] if not linear_input else linear_to_srgb(o_rgba[..., :3])
     f = f_rgba[..., :3] if not linear_input else linear_to_srgb(f_rgba[..., :3])
+    edges = gradient_magnitude(o) >= EDGE_GRADIENT
+    # The two fits of F read only the pair: they run beside O's compression and blend space.
+    lowpass_ahead = ahead.submit(fit_lowpass, o, f)
+    transfer_ahead = ahead.submit(fit_pointwise, o, f, edges)
     compression = compression_evidence(o, quantization)
     readings.append(compression)
     space, residuals = choose_blend_space(o_rgba, linear_input, lossless=not compression.compressed)
     fit = residuals[space]
-    lowpass, kernel_residual, _ = fit_lowpass(o, f)
+    lowpass, kernel_residual, _ = lowpass_ahead.result()
     if lowpass:
         return PairAnalysis(space, 0.0, f"F is a low-pass (blur) of O (kernel residual {kernel_residual:.3f}): kept F",
                             Decision.LOWPASS_KEPT, forcing=forcing_advice(Decision.LOWPASS_KEPT))
-    edges = gradient_magnitude(o) >= EDGE_GRADIENT
     # A grey (or faintly tinted) O cannot tell its antialiasing space (blend_space falls back to linear light), so
     # an affine map of its encoded values (Pillow's autocontrast, a levels stretch) is tested
     # too: tuning half, the screentone manga under Pillow's autocontrast, affine in sRGB values
@@ -336,8 +342,8 @@ def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterat
             return PairAnalysis(space, 0.0, f"F is an affine map of O in {affine_space} values on {affine:.3f} of the "
                                             "edges, so its edges are already right: kept F", Decision.AFFINE_KEPT,
                                 forcing=forcing_advice(Decision.AFFINE_KEPT))
-    transfer = fit_pointwise(o, f, edges)
     textured, texture = is_textured(o, fit, compression)
+    transfer = transfer_ahead.result()
     # A comic's screentone reads as texture, but it is a drawing (plan/hatching.py): under a
     # point-wise filter it takes the hard-edged branch below, as under a neighbourhood filter.
     # Tuning half, the manga pages under the 19 point-wise tool filters: PNG 0.432 -> 0.560 of
@@ -443,6 +449,16 @@ def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterat
                                         f"match) on hard-edged content: full strength{thin}",
                             Decision.POINTWISE_HARD_EDGED, prior)
     if transfer.consistency >= POINTWISE_SHARE:
+        def drawn_prior():
+            return drawn_only(pure_colour_prior(o, transfer, space, f, edges, noise_contrast=compression.contrast,
+                                                extend_ends=not compression.compressed, ridge_noise=compression.contrast,
+                                                luma_purity=COMPRESSED_LUMA_PURITY if compression.compressed else 0.0),
+                              o, edges, ink=not grey,
+                              ink_span=COMPRESSED_INK_SPAN if compression.compressed else FLAT_SPAN)
+
+        # The pure colours below are needed only at a strength in (0, 1): beside the calibration
+        # they are read while it runs (and dropped where it chose another); in order, after it.
+        prior_ahead = None if isinstance(ahead, InOrder) else ahead.submit(drawn_prior)
         strength, errors = calibrate_strength(o, transfer, f, space, sigma_d, sigma_e, iterations)
         why = (f"point-wise filter (key {transfer.key}, {transfer.consistency:.3f} of edges match); "
                f"half-resolution calibration chose strength {strength:g}")
@@ -484,11 +500,7 @@ def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterat
         # half the edge pixels of a photo (rocket and chelsea 0.70-0.77, the bench's photo-like
         # pair 0.49), so the pure colours' passes run over all of O's blocks: that pair's tiles
         # took 4-5 times as long (2.1 -> 8-11 s on llvmpipe), for a hundredth of the edge error.
-        prior = drawn_only(pure_colour_prior(o, transfer, space, f, edges, noise_contrast=compression.contrast,
-                                             extend_ends=not compression.compressed, ridge_noise=compression.contrast,
-                                             luma_purity=COMPRESSED_LUMA_PURITY if compression.compressed else 0.0),
-                           o, edges, ink=not grey,
-                           ink_span=COMPRESSED_INK_SPAN if compression.compressed else FLAT_SPAN)
+        prior = drawn_prior() if prior_ahead is None else prior_ahead.result()
         thin = ", pure colours of thin features there" if prior is not None else ""
         return PairAnalysis(space, 1.0, why + " for textured regions, full strength for hard-edged ones" + thin,
                             Decision.POINTWISE_CALIBRATED, prior, local=LocalStrength(strength),
