@@ -1,9 +1,9 @@
 """A second thread for the analyses that need nothing decided before them.
 
 The plan's decisions are taken in order, each on what the ones before found; a few of its
-analyses read only O and F (the low-pass fit, the point-wise fit, the calibration once the
-table is known) and run beside them in a second thread, NumPy releasing the GIL in its array
-operations. The plans are the same (``tests/test_plan_ahead.py`` runs every decision both
+analyses read only what is known when they start (the low-pass and point-wise fits of F,
+the gated pure colours while the calibration runs) and run beside them in a second thread,
+NumPy releasing the GIL in its array operations. The plans are the same (``tests/test_plan_ahead.py`` runs every decision both
 ways). Measured on the bench's 4096 x 4096 pairs: docs/performance.md.
 
 They run in order in the calling thread instead where the process's address space is
@@ -12,7 +12,7 @@ each thread that calls it, which such a limit may not hold, and OpenBLAS reports
 on its own line, beside the command's (``tests/test_out_of_memory.py``); and in a process that
 plans beside others on every core (a batch's analysis processes, :func:`plan_in_order`), where
 the second thread finds no core free: 20 pairs of 1080p through ``aarecovery batch`` with its
-default two processes, 2.04 images/s in order against 1.95 with the thread.
+default two processes, one run each, 2.04 images/s in order against 1.95 with the thread.
 """
 
 import ctypes
@@ -71,7 +71,8 @@ def analyses_ahead():
     concurrent.futures.Executor or InOrder
         One worker thread, joined when the block ends (a decision taken before a submitted
         analysis was read waits for it, so that nothing of the plan runs on beside the
-        passes); :class:`InOrder` where the address space is limited.
+        passes); :class:`InOrder` where the address space is limited or after
+        :func:`plan_in_order`.
     """
     if _in_order or _address_space_limited():
         yield InOrder()
