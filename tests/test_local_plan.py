@@ -125,6 +125,33 @@ def test_gl_computes_the_same_strength_map_as_numpy(banner_over_photo, gl_path):
         np.testing.assert_allclose(tiled_maps.strength, gl_maps.strength, atol=_FACTOR_TOLERANCE, err_msg=name)
 
 
+@pytest.mark.parametrize("gather", [True, False], ids=["gathered", "one-texel-a-read"])
+@pytest.mark.parametrize("shape", [(37, 29), (16, 9), (1, 23), (40, 1)], ids=lambda shape: "x".join(map(str, shape)))
+def test_gl_counts_the_flat_regions_as_numpy_at_every_border(shape, gather, gl_path):
+    """The region sums (passes 2 and 3, 17 texels along a row, then a column) both ways the
+    backend reads them: two texels a textureGather (GL 4.0), and one a texelFetch (GL 3.3),
+    on odd sizes whose windows cross every border."""
+    rng = np.random.default_rng(sum(shape))
+    original = np.rint(rng.uniform(0.2, 0.9, shape + (3,)) * 255).astype(np.float32) / 255
+    flat = rng.random(shape) < 0.5
+    flat[: shape[0] // 2] = True
+    original[flat] = (0.7, 0.6, 0.5)
+    filtered = np.where(original.mean(axis=2, keepdims=True) > 0.55, 1.0, 0.0).astype(np.float32)
+    filtered = np.repeat(filtered, 3, axis=2)
+    maps = {}
+    for backend in ("numpy", "gl"):
+        with aarecovery.Engine(backend, gl_path=gl_path if backend == "gl" else "auto") as engine:
+            if backend == "gl":
+                engine._impl.gather_region_sums = gather
+            engine.set_images(original, filtered)
+            plan = dataclasses.replace(engine.plan(), strength=1.0, local=LocalStrength(0.25), pure_colours=None,
+                                       toward_original=False)
+            engine.run(plan, maps=True)
+            maps[backend] = engine.maps().strength
+    assert maps["numpy"].min() < 0.5 < maps["numpy"].max()
+    np.testing.assert_allclose(maps["gl"], maps["numpy"], atol=_FACTOR_TOLERANCE)
+
+
 def test_the_summary_says_how_the_image_divided(banner_over_photo):
     case = banner_over_photo
     with aarecovery.Engine("numpy") as engine:

@@ -194,6 +194,9 @@ class GLBackend:
         #: its own: called with the pass's label and its seconds, the context finished
         #: before and after it (the device's time for that pass, and the wait).
         self.pass_clock = None
+        #: Whether the local plan's region sums read two texels at a time (``textureGather``,
+        #: GL 4.0; ``local_plan.glsl``); the tests switch it off to check GL 3.3's loop.
+        self.gather_region_sums = self.context.version_code >= 400
         self._classifier = BlockClassifier(self.context, compute="compute" in self.capabilities.gl_paths,
                                            runs=path == "fragment")
         self._textures = {}
@@ -574,7 +577,8 @@ class GLBackend:
         if self._factor_for in ((local, ink_gate, ink_span, False, None),
                                 (local, ink_gate, ink_span, for_beta, blocks and blocks[1])):
             return
-        defines = {"LOCAL_ENCODE": int(self._linear["original"]), "INK_BY_LUMA": int(ink_gate and ink_span > FLAT_SPAN)}
+        defines = {"LOCAL_ENCODE": int(self._linear["original"]), "INK_BY_LUMA": int(ink_gate and ink_span > FLAT_SPAN),
+                   "REGION_GATHER": int(self.gather_region_sums)}
         last_inputs = {"local_input": self._work("local_rows"), "original_image": self._textures["original"]}
         if for_beta:
             last_inputs["filtered_image"] = self._textures["filtered"]

@@ -1,5 +1,9 @@
 #version 330 core
 // One pass of the local plan's factor over the whole image (local_plan.glsl does the work).
+#if REGION_GATHER
+// Where the backend asks for it, its context has GL 4.0, which includes the extension.
+#extension GL_ARB_texture_gather : require
+#endif
 #include "colour.glsl"
 #include "local_plan.glsl"
 
