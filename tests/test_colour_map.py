@@ -1,13 +1,16 @@
 """The 3-D colour-map fit (``aarecovery.plan.colour_map``): palette quantisers are found,
 neighbourhood filters are not, and the table reproduces the map where O has samples."""
 
+import dataclasses
+
 import numpy as np
 
 import aarecovery
 from aarecovery import Decision
 from aarecovery.plan.analysis import analyse
 from aarecovery.plan.calibration import EDGE_GRADIENT
-from aarecovery.plan.colour_map import COLOUR_MAP_SHARE, fit_colour_map
+from aarecovery.plan.colour_map import COLOUR_MAP_SHARE, INDEXED_COLOURS, fit_colour_map, indexed_colour_prior
+from aarecovery.spec.pure_colours import COLOUR_KEY, transfer_encoded
 from aarecovery.spec.sobel import gradient_magnitude
 
 
@@ -87,7 +90,8 @@ def test_an_indexed_colour_drawing_is_repaired_as_a_point_wise_map(backend):
     """A map converted to indexed colour (Pillow's median cut to 6 colours, no dithering): no
     table of one key explains it, and its flat palette colours read as a smoothing filter
     that keeps flat colours, which lost 0.66 dB against F (-0.163 of the edge error). As a
-    colour map on hard-edged content, full strength: 0.455 measured (NumPy)."""
+    colour map on hard-edged content, full strength: 0.455 measured (NumPy); with its thin
+    features' pure colours through the 3-D table, 0.777 on both backends."""
     from aarecovery.lab import realtools
     from aarecovery.lab.metrics import edge_band, error_reduction
     suite = realtools.RealToolsSuite("indexed", ("maps",), ("pil-quantize",), 96, {"maps": ("linear",)})
@@ -97,9 +101,10 @@ def test_an_indexed_colour_drawing_is_repaired_as_a_point_wise_map(backend):
         engine.set_images(case.original, case.filtered)
         plan = engine.plan()
         assert plan.decision == Decision.COLOUR_MAP_HARD_EDGED, plan.reason
+        assert plan.pure_colours is not None and plan.pure_colours.key == COLOUR_KEY, plan.reason
         engine.run(plan)
         repaired = engine.result()
-    assert error_reduction(repaired, case.filtered, case.reference, band) > 0.4
+    assert error_reduction(repaired, case.filtered, case.reference, band) > 0.75
 
 
 def test_a_bilateral_filter_on_flat_colours_is_no_colour_map():
@@ -115,3 +120,56 @@ def test_a_bilateral_filter_on_flat_colours_is_no_colour_map():
     opaque = np.ones(case.original.shape[:2] + (1,), np.float32)
     analysis = analyse(np.concatenate([case.original, opaque], -1), np.concatenate([case.filtered, opaque], -1))
     assert analysis.decision == Decision.NEIGHBOURHOOD_HARD_EDGED, analysis.reason
+
+
+def test_only_indexed_colour_gets_pure_colours_through_the_table():
+    """F with a palette's few colours is indexed; a smooth map of every colour (channels
+    swapped and scaled, as a hue change keeps O's many colours) is not: its table's bins far
+    from O's colours are guesses."""
+    original = _photo_like(seed=4)
+    edges = gradient_magnitude(original) >= EDGE_GRADIENT
+    indexed = _quantise(original, PALETTE)
+    prior = indexed_colour_prior(original, indexed, fit_colour_map(original, indexed, edges))
+    assert prior is not None and prior.key == COLOUR_KEY and prior.table.shape == (32, 32, 32, 3)
+    assert not prior.explain_filtered
+    smooth = (original[..., ::-1] * 0.9).astype(np.float32)
+    assert indexed_colour_prior(original, smooth, fit_colour_map(original, smooth, edges)) is None
+    # Many colours kept, though fewer than INDEXED_COLOURS: the share decides.
+    few = np.round(original * 5) / 5
+    assert len(np.unique(few.reshape(-1, 3), axis=0)) <= INDEXED_COLOURS
+    assert indexed_colour_prior(original, few.astype(np.float32), fit_colour_map(original, few, edges)) is not None
+    assert indexed_colour_prior(few.astype(np.float32), few.astype(np.float32),
+                                fit_colour_map(few, few, edges)) is None
+
+
+def test_the_colour_key_reads_the_fitted_map():
+    """The specification's f for the colour key (what the passes read, transfer_encoded) is the
+    fitted 3-D table's trilinear reading."""
+    original = _photo_like(seed=5)
+    filtered = _quantise(original, PALETTE)
+    fitted = fit_colour_map(original, filtered, gradient_magnitude(original) >= EDGE_GRADIENT)
+    planes = np.ascontiguousarray(original.reshape(-1, 3).T)
+    np.testing.assert_array_equal(transfer_encoded(planes, COLOUR_KEY, fitted.table).T, fitted(original.reshape(-1, 3)))
+
+
+def test_gl_extends_thin_features_through_a_colour_map_as_numpy(gl_path):
+    """TABLE_KEY 9 (a 3-D texture read trilinearly, transfer_table.glsl) gives the NumPy
+    specification's result on both GL paths, tiled and whole: the sRGB map under Pillow's
+    quantize to 6 colours."""
+    from parity import assert_results_agree
+    from aarecovery.lab import realtools
+    suite = realtools.RealToolsSuite("indexed", ("maps",), ("pil-quantize",), 96, {"maps": ("srgb",)})
+    (case,) = realtools.build_cases(suite, "tune", jpeg=False)
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        plan = engine.plan()
+        assert plan.pure_colours is not None and plan.pure_colours.key == COLOUR_KEY, plan.reason
+        engine.run(plan)
+        expected = engine.result()
+        engine.run(dataclasses.replace(plan, pure_colours=None))
+        without = engine.result()
+    assert np.abs(expected - without).max() > 0.1  # the extension acts
+    with aarecovery.Engine("gl", gl_path=gl_path) as engine:
+        for tile in (None, 64):
+            assert_results_agree(aarecovery.recover(case.original, case.filtered, engine=engine, tile_size=tile),
+                                 expected, f"{gl_path} tile {tile}")

@@ -83,7 +83,7 @@ from ..spec.sobel import gradient_magnitude
 from .ahead import InOrder, analyses_ahead
 from .blend_space import choose_blend_space, means_tell_srgb
 from .calibration import EDGE_GRADIENT, calibrate_strength
-from .colour_map import COLOUR_MAP_SHARE, HARD_EDGED_COLOUR_MAP_SHARE, fit_colour_map
+from .colour_map import COLOUR_MAP_SHARE, HARD_EDGED_COLOUR_MAP_SHARE, fit_colour_map, indexed_colour_prior
 from .compression import (COMPRESSED_HARD_EDGED_BLEND_SPACE, COMPRESSED_REPAIR_TO_ERROR, COMPRESSED_SHARPENED_BLEND_SPACE,
                           COMPRESSED_SHARPENED_STRENGTH, COMPRESSED_SMOOTHED_BLEND_SPACE, COMPRESSED_SMOOTHED_STRENGTH,
                           GRID_MARGIN, compression_evidence, hidden_compression)
@@ -630,20 +630,28 @@ def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterat
     # kept 0.08 of its error (sRGB), where the paper's passes at full strength remove 0.455
     # and 0.365. The 3-D table (plan/colour_map.py) tells it from the neighbourhood filters at
     # a higher share than on a photo (HARD_EDGED_COLOUR_MAP_SHARE): full strength, or on a
-    # JPEG the strength calibrated with that table; no pure colours (the backends' tables
-    # have one key).
+    # JPEG the strength calibrated with that table. Where F is indexed colour, thin features
+    # get pure colours through that table (colour_map.indexed_colour_prior): tuning half, the
+    # map under Pillow's quantize 0.455 -> 0.777 and 0.365 -> 0.775 of its edge error, the
+    # icons 0.976-0.982 -> 0.989-0.992; no other case moved. On a JPEG above its noise, as
+    # for a table of one key: serif at q 98 (linear light) 0.405 -> 0.643, the one JPEG case
+    # of the tuning half that reads as a hard-edged colour map.
     colour_map = fit_colour_map(o, f, edges)
     if colour_map.consistency >= HARD_EDGED_COLOUR_MAP_SHARE:
         why = (f"point-wise colour map ({colour_map.consistency:.3f} of edges match, repair-to-error ratio "
                f"{ratio:.1f}) on hard-edged content")
         if compression.compressed:
             strength, errors = calibrate_strength(o, colour_map, f, space, sigma_d, sigma_e, iterations)
-            return PairAnalysis(space, strength, why + f" above {compression.describe()}; half-resolution "
-                                                       f"calibration chose strength {strength:g}",
-                                Decision.COLOUR_MAP_HARD_EDGED,
+            prior = indexed_colour_prior(o, f, colour_map, compression.contrast, COMPRESSED_LUMA_PURITY)
+            thin = ", pure colours of thin features" if prior is not None and strength > 0 else ""
+            return PairAnalysis(space, strength, why + thin + f" above {compression.describe()}; half-resolution "
+                                                              f"calibration chose strength {strength:g}",
+                                Decision.COLOUR_MAP_HARD_EDGED, prior if strength > 0 else None,
                                 forcing=forcing_advice(Decision.COLOUR_MAP_HARD_EDGED, errors=errors) if strength == 0
                                 else None)
-        return PairAnalysis(space, 1.0, why + ": full strength", Decision.COLOUR_MAP_HARD_EDGED)
+        prior = indexed_colour_prior(o, f, colour_map)
+        thin = ", pure colours of thin features" if prior is not None else ""
+        return PairAnalysis(space, 1.0, why + ": full strength" + thin, Decision.COLOUR_MAP_HARD_EDGED, prior)
     # A smoothing filter also leaves some edges as O had them (a bilateral filter's strong
     # edges), and so does the reference: there the confidence falls to 0 (UNTOUCHED_SPAN, in
     # the model's pass).

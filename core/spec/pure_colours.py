@@ -83,7 +83,7 @@ from .sobel import ridge_magnitude, sobel_magnitude
 
 __all__ = ["PureColourPrior", "is_flat_colour", "PALETTE_SIZE", "INK_COUNT", "ON_LINE_TOLERANCE", "KEPT_CONTRAST", "EXTENSION_KEYS",
            "SCALE_KEYS", "SHIFT_KEYS", "filtered_colour", "transfer_encoded", "extend_extreme", "scale_transfer", "key_values", "shift_grey",
-           "rec601_grey", "fit_pure_colour_model", "RIDGE_EDGE_SCALE", "possible_ridges"]
+           "rec601_grey", "fit_pure_colour_model", "RIDGE_EDGE_SCALE", "possible_ridges", "COLOUR_KEY", "colour_map_at"]
 
 #: Most palette colours kept (a uniform array in the GL pass).
 PALETTE_SIZE = 32
@@ -183,11 +183,15 @@ MIN_CONTRAST = 8.5 / 255
 #: as OpenCV's YCrCb, ``"luma601_floor_shift"`` as Pillow's YCbCr. Column 0 of the table holds
 #: the offset per grey level.
 SHIFT_KEYS = ("luma601_shift", "luma601_floor_shift")
+#: The key of a 3-D colour map (``aarecovery.plan.colour_map``: a palette quantiser): the whole
+#: encoded colour indexes a table of shape (B, B, B, 3), read between bin centres
+#: (:func:`colour_map_at`).
+COLOUR_KEY = "colour"
 #: Table keys for which the extension is used (see the module notes).
 EXTENSION_KEYS = ("channel", "luma", "luma_scale", "luminance_scale", "luminance", "luminance_d50",
-                  "luma601") + SHIFT_KEYS
+                  "luma601") + SHIFT_KEYS + (COLOUR_KEY,)
 _KEY_CODES = {"channel": 0, "luma": 1, "luma_scale": 2, "luminance_scale": 3, "luminance": 4, "luminance_d50": 5,
-              "luma601_shift": 6, "luma601_floor_shift": 7, "luma601": 8}
+              "luma601_shift": 6, "luma601_floor_shift": 7, "luma601": 8, COLOUR_KEY: 9}
 # The tools' fixed-point Rec. 601 Y of 8-bit R, G, B (each matched 262,144 random colours
 # exactly): OpenCV's weights in 1/16384 with rounding; Pillow's YCbCr sums its weights times
 # 64, each rounded to a whole number, and truncates (its Y is a level below the rounded
@@ -222,10 +226,11 @@ class PureColourPrior:
         (encoded) or luminance (linear) and scale colour with it (:func:`scale_transfer`);
         the shift keys add an offset of the 8-bit Rec. 601 grey to every channel
         (:data:`SHIFT_KEYS`); ``"luma601"`` indexes every column by that grey, rounded
-        (:func:`rec601_grey`: OpenCV's colour maps of a colour image).
-    table : ndarray of float32, shape (256, 3)
+        (:func:`rec601_grey`: OpenCV's colour maps of a colour image); :data:`COLOUR_KEY`
+        indexes a 3-D table by the whole colour (a palette quantiser).
+    table : ndarray of float32, shape (256, 3), or (B, B, B, 3) for :data:`COLOUR_KEY`
         Encoded output colour per bin of the key; read with linear interpolation between
-        bin centres ``(i + 0.5) / 256``.
+        bin centres ``(i + 0.5) / 256`` (trilinear for the colour key: :func:`colour_map_at`).
     palette : ndarray of float32, shape (N, 3), N <= PALETTE_SIZE
         sRGB-encoded flat colours of O.
     key_low, key_high : ndarray of float32, shape (3,), optional
@@ -328,6 +333,37 @@ def _table_at(column, keys):
     fraction = position - lower.astype(np.float32)
     below, above = column[lower], column[lower + 1]
     return below + (above - below) * fraction
+
+
+def colour_map_at(table, encoded):
+    """A 3-D table of encoded colour read at encoded colours, trilinearly between bin centres
+    ``(i + 0.5) / B`` (clamped at the outer ones).
+
+    Parameters
+    ----------
+    table : ndarray of float32, shape (B, B, B, 3)
+        Output colour per bin of (R, G, B).
+    encoded : ndarray of float32, shape (..., 3)
+
+    Returns
+    -------
+    ndarray of float32, shape (..., 3)
+    """
+    # The corners in this order, each weight a product over R, G, B: GL's colour_map_at
+    # (transfer_table.glsl) sums them the same way.
+    bins = table.shape[0]
+    position = np.clip(encoded * np.float32(bins) - np.float32(0.5), 0, bins - 1).astype(np.float32)
+    low = np.minimum(position.astype(np.intp), bins - 2)
+    weight = (position - low).astype(np.float32)
+    result = np.zeros(encoded.shape, np.float32)
+    for corner in range(8):
+        step = [(corner >> axis) & 1 for axis in range(3)]
+        corner_weight = np.ones(encoded.shape[:-1], np.float32)
+        for axis in range(3):
+            corner_weight *= weight[..., axis] if step[axis] else np.float32(1) - weight[..., axis]
+        value = table[low[..., 0] + step[0], low[..., 1] + step[1], low[..., 2] + step[2]]
+        result += corner_weight[..., None] * value
+    return result
 
 
 def scale_transfer(encoded, key, table, keys=None):
@@ -437,7 +473,7 @@ def transfer_encoded(encoded, key, table, keys=None):
         sRGB-encoded colour planes.
     key : str
         One of :data:`EXTENSION_KEYS`.
-    table : ndarray of float32, shape (256, 3)
+    table : ndarray of float32, shape (256, 3), or (B, B, B, 3) for :data:`COLOUR_KEY`
         Encoded output colour per bin of the key (see :class:`PureColourPrior`).
     keys : ndarray of float32, shape (3, N), optional
         The table keys to read at (:func:`key_values`, perhaps clamped); default: the
@@ -447,6 +483,8 @@ def transfer_encoded(encoded, key, table, keys=None):
     -------
     ndarray of float32, shape (3, N)
     """
+    if key == COLOUR_KEY:
+        return colour_map_at(table, np.ascontiguousarray(encoded.T)).T
     if keys is None:
         keys = key_values(encoded, key)
     if key in SCALE_KEYS:

@@ -606,10 +606,23 @@ class GLBackend:
         self._work("strength").write(strength_map(plan, factor, self._key[0][::-1]))
 
     def _transfer_table(self, prior):
-        """The filter's table (3 KB): per run, as it belongs to the plan, not to the loaded pair."""
+        """The filter's table (3 KB; a colour map's 3-D table 384 KB): per run, as it belongs
+        to the plan, not to the loaded pair."""
+        table = np.ascontiguousarray(prior.table, np.float32)
+        if table.ndim == 4:
+            # (R, G, B, 3) in C order: the texture's x runs along B (transfer_table.glsl).
+            texture = self._textures.get("transfer_map")
+            if texture is None or texture.size != table.shape[2::-1]:
+                if texture is not None:
+                    texture.release()
+                texture = self._textures["transfer_map"] = self.context.texture3d(table.shape[2::-1], 3, dtype="f4")
+                texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+                texture.repeat_x = texture.repeat_y = texture.repeat_z = False
+            texture.write(table)
+            return texture
         if "transfer_table" not in self._textures:
             self._textures["transfer_table"] = self._texture((256, 1), 3, "f4")
-        self._textures["transfer_table"].write(np.ascontiguousarray(prior.table, np.float32))
+        self._textures["transfer_table"].write(table)
         return self._textures["transfer_table"]
 
     def _transfer_bends(self, ramp):

@@ -2,7 +2,11 @@
 // colours of thin features and the ramp lookup. Twin: key_values, transfer_encoded and
 // _table_at in aarecovery/spec/pure_colours.py. Needs colour.glsl.
 
+#if TABLE_KEY == 9
+uniform sampler3D transfer_table;  // B x B x B: a colour map, encoded output per bin of (R, G, B)
+#else
 uniform sampler2D transfer_table;  // 256 x 1: the filter's table, encoded output per key bin
+#endif
 
 // The key is a compile-time define, not a uniform: llvmpipe runs both sides of every branch
 // under a mask, so a uniform switch paid for every key's sRGB conversions (pow) at every
@@ -14,6 +18,7 @@ uniform sampler2D transfer_table;  // 256 x 1: the filter's table, encoded outpu
 //            6/7: the 8-bit Rec. 601 grey (rounded / truncated) indexes an offset added to
 //            every channel (SHIFT_KEYS, shift_grey)
 //            8: the 8-bit Rec. 601 grey, rounded, indexes all (rec601_grey)
+//            9: the whole colour indexes a 3-D table (colour_map_at: a palette quantiser)
 #ifndef TABLE_KEY
 #define TABLE_KEY 0
 #endif
@@ -26,6 +31,28 @@ const vec4 OPENCV_Y = vec4(4899.0, 9617.0, 1868.0, 16384.0);
 const vec4 PILLOW_Y = vec4(19.136, 37.568, 7.296, 64.0);
 const vec4 REC601_Y = vec4(299.0, 587.0, 114.0, 1000.0);
 
+#if TABLE_KEY == 9
+// The 3-D table between bin centres (i + 0.5) / B, trilinearly: the corners in the
+// specification's order, each weight a product over R, G, B (colour_map_at). The texture's
+// x runs along B, its z along R.
+vec3 colour_map_at(vec3 encoded) {
+    int bins = textureSize(transfer_table, 0).x;
+    vec3 position = clamp(encoded * float(bins) - 0.5, 0.0, float(bins - 1));
+    ivec3 low = min(ivec3(position), ivec3(bins - 2));
+    vec3 weight = position - vec3(low);
+    vec3 result = vec3(0.0);
+    for (int corner = 0; corner < 8; ++corner) {
+        ivec3 step = ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+        float corner_weight = 1.0;
+        corner_weight *= step.x == 1 ? weight.x : 1.0 - weight.x;
+        corner_weight *= step.y == 1 ? weight.y : 1.0 - weight.y;
+        corner_weight *= step.z == 1 ? weight.z : 1.0 - weight.z;
+        ivec3 bin = low + step;
+        result += corner_weight * texelFetch(transfer_table, bin.zyx, 0).rgb;
+    }
+    return result;
+}
+#else
 float table_at(float key, int channel) {
     // Linear interpolation between bin centres, two fetches (no texture filtering: llvmpipe's
     // filtering weights are not exact).
@@ -47,9 +74,11 @@ vec3 table_row_at(float key) {
     return below + (above - below) * fraction;
 }
 
+#endif
+
 // The table keys of an encoded colour, one per table column (key_values).
 vec3 key_values(vec3 encoded) {
-#if TABLE_KEY == 0
+#if TABLE_KEY == 0 || TABLE_KEY == 9
     return encoded;
 #elif SHIFT_KEY
     // The grey level as the tool computes it from the 8-bit channels, at its bin's centre
@@ -95,6 +124,8 @@ vec3 transfer_encoded(vec3 encoded, vec3 keys) {
     return clamp(encoded + vec3(table_at(keys.r, 0)), 0.0, 1.0);
 #elif TABLE_KEY == 0
     return vec3(table_at(keys.r, 0), table_at(keys.g, 1), table_at(keys.b, 2));
+#elif TABLE_KEY == 9
+    return colour_map_at(encoded);
 #else
     return table_row_at(keys.r);  // one key for all columns
 #endif
