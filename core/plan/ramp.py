@@ -13,7 +13,7 @@ none down), and the lookup's pass would read O and F around every pixel of F's a
 for nothing a user sees.
 """
 
-from ..spec.pure_colours import EXTENSION_KEYS
+from ..spec.pure_colours import COLOUR_KEY, EXTENSION_KEYS
 from ..spec.ramp_lookup import RAMP_BEND, RampTable, table_bends
 
 __all__ = ["RAMP_WINDOW", "ROUNDING_BEND", "ramp_table_of"]
@@ -38,7 +38,8 @@ ROUNDING_BEND = 2.0 / 255
 
 def ramp_table_of(transfer, prior):
     """The table the ramp lookup reads: the pure colours' when the plan has them (the backends
-    hold one table), else the fitted transfer's; None where its key has no GL twin.
+    hold one table), else the fitted transfer's; None where its key has no GL twin, and where
+    the pure colours read a 3-D colour map (``plan.colour_map.indexed_colour_prior``).
 
     Parameters
     ----------
@@ -51,6 +52,9 @@ def ramp_table_of(transfer, prior):
         None also for a table that bends by at most ``RAMP_BEND`` beyond rounding in every
         span of :data:`RAMP_WINDOW` bins.
     """
+    if prior is not None and prior.key == COLOUR_KEY:
+        # The passes hold one table, and the ramp lookup's is of one key.
+        return None
     if prior is not None:
         table = RampTable(prior.key, prior.table)
     elif transfer.key in EXTENSION_KEYS:
