@@ -22,7 +22,7 @@ from ..colour import largest_channel
 from ..spec.pure_colours import COLOUR_KEY, PureColourPrior, colour_map_at
 from .pure_colours import inks_of, palette_of
 
-__all__ = ["ColourMapTransfer", "fit_colour_map", "indexed_colour_prior", "COLOUR_MAP_SHARE",
+__all__ = ["ColourMapTransfer", "fit_colour_map", "indexed_colour_prior", "indexed_colour_fallback", "COLOUR_MAP_SHARE",
            "HARD_EDGED_COLOUR_MAP_SHARE", "INDEXED_COLOURS", "INDEXED_SHARE"]
 
 # Bins per channel: 8/255 wide, not swept. Finer bins hold fewer pixels each to leave one out
@@ -177,3 +177,26 @@ def indexed_colour_prior(original, filtered, colour_map, noise_contrast=0.0, lum
     return PureColourPrior(COLOUR_KEY, colour_map.table, palette_of(original), explain_filtered=False,
                            inks=inks_of(original), noise_contrast=float(noise_contrast), ridge_noise=float(noise_contrast),
                            luma_purity=float(luma_purity))
+
+
+def indexed_colour_fallback(original, filtered, edges, noise_contrast=0.0, luma_purity=0.0):
+    """:func:`indexed_colour_prior` where no table of one key gave the pure colours: for F that
+    such a table explains but no extension key reads (the channels' mean), if the 3-D table
+    explains it as on hard-edged content (:data:`HARD_EDGED_COLOUR_MAP_SHARE`).
+
+    Parameters
+    ----------
+    original, filtered : ndarray of float32, shape (H, W, 3)
+        Encoded colour of the analysis window.
+    edges : ndarray of bool, shape (H, W)
+    noise_contrast, luma_purity : float, optional
+        As for :func:`indexed_colour_prior`.
+
+    Returns
+    -------
+    PureColourPrior or None
+    """
+    colour_map = fit_colour_map(original, filtered, edges)
+    if colour_map.consistency < HARD_EDGED_COLOUR_MAP_SHARE:
+        return None
+    return indexed_colour_prior(original, filtered, colour_map, noise_contrast, luma_purity)
