@@ -11,7 +11,9 @@ depends on the pixel's surroundings, score far lower (measured below).
 
 The table serves self-calibration on textured images and JPEG drawings
 (``plan.calibration``), which applies ``f`` to colours O does not hold (blends at half
-resolution); empty bins take the mean of their filled neighbours, grown outwards. On
+resolution); empty bins take the mean of their filled neighbours, grown outwards. Where F is
+indexed colour it also gives the pure colours of thin features their filtered colour
+(:func:`indexed_colour_prior`). On
 hard-edged content its share alone tells a colour map from a neighbourhood filter
 (:data:`HARD_EDGED_COLOUR_MAP_SHARE`).
 """

@@ -43,6 +43,11 @@ filtered directly:
   value, such as JET): tables that match colour to grey or a hue swap by coincidence zigzag,
   and extending with them lost up to 7.9 dB (chart).
 
+* A palette quantiser (indexed colour) is point-wise but no table of one key explains it on
+  a colour drawing: its 3-D table of the whole colour (:data:`COLOUR_KEY`,
+  :func:`colour_map_at`; ``aarecovery.plan.colour_map.indexed_colour_prior``) gives the
+  extended colour its filtered colour instead.
+
 * Over a photo (text, logos and interface chrome drawn on it, ``PureColourPrior.drawn_only``)
   the extension acts only in the regions the local plan reads as drawn, by their smooth
   weight (the ``gate`` of :func:`fit_pure_colour_model`): a partial colour is extended that
