@@ -322,7 +322,8 @@ class PureColourPrior:
     @property
     def key_code(self):
         """int: the GL define ``TABLE_KEY`` (0 channel, 1 luma, 2 luma_scale, 3 luminance_scale,
-        4 luminance, 5 luminance_d50, 6 luma601_shift, 7 luma601_floor_shift, 8 luma601)."""
+        4 luminance, 5 luminance_d50, 6 luma601_shift, 7 luma601_floor_shift, 8 luma601,
+        9 colour)."""
         return _KEY_CODES[self.key]
 
     def palette_in(self, blend_space):
