@@ -202,6 +202,33 @@ def test_towards_o_leaves_a_changed_colour_to_the_model():
     np.testing.assert_array_equal(jacobi_step(original, original, model), original)
 
 
+def test_towards_o_takes_the_largest_gate_around_the_pixel():
+    """The blended pixels between a drawing's flat colours recur nowhere, and the gate reads
+    them as less drawn than the colours beside them: the weight towards O is the largest gate
+    over the pixel's 3 x 3 neighbourhood, borders replicated, so the edge pixel beside a
+    drawn colour moves to O's pixel."""
+    from aarecovery.spec import fit_blend_model, jacobi_step
+    from aarecovery.spec.blend_model import toward_weight
+    gate = np.zeros((5, 6), np.float32)
+    gate[2, 3], gate[0, 0] = 0.8, 0.3
+    expected = np.zeros((5, 6), np.float32)
+    expected[:2, :2] = 0.3
+    expected[1:4, 2:5] = 0.8
+    np.testing.assert_array_equal(toward_weight(gate), expected)
+
+    width = 9
+    ramp = np.clip(np.arange(width, dtype=np.float32) - 3.5, 0, 1)
+    original = np.ones((5, width, 4), np.float32)
+    original[..., :3] = (1 - ramp)[None, :, None] * np.float32(0.1) + ramp[None, :, None] * np.float32(0.9)
+    softened = original.copy()
+    softened[:, 4, :3] = 0.5  # the edge pixel softened, the flat colours kept
+    drawn = np.zeros((5, width), np.float32)
+    drawn[:, 3] = drawn[:, 5] = 1  # the flat colours beside the edge read as drawn, the blend not
+    model = fit_blend_model(original, softened, 0.1, 0.01, toward=toward_weight(drawn))
+    assert model.edge[2, 4] > 0 and model.toward[2, 4] == 1 and model.beta[2, 4] == 0
+    np.testing.assert_allclose(jacobi_step(softened, softened, model)[2, 4], original[2, 4], atol=1e-6)
+
+
 @pytest.mark.gl
 def test_towards_o_is_the_same_on_gl_tiled_and_whole(gl_path):
     """The gate comes from the local plan's passes also for a plan without a local plan (a
@@ -226,6 +253,8 @@ def test_towards_o_is_the_same_on_gl_tiled_and_whole(gl_path):
             engine.run(each, maps=True)
             assert_results_agree(engine.result(), expected, message)
             assert_maps_agree(engine.maps(), expected_maps, message=message)
+            engine.run(each)  # the factor over the listed blocks only
+            assert_results_agree(engine.result(), expected, f"{message}, listed blocks")
         tiled = aarecovery.recover(case.original, case.filtered, backend="gl", gl_path=gl_path, plan=each,
                                    tile_size=64)
         assert_results_agree(tiled, expected, f"{message}, tiled")

@@ -157,7 +157,9 @@ class Plan:
     @property
     def reach(self):
         """int: how far beyond the model's own neighbourhood the plan reads O (the local
-        plan's factor, or its gate towards O; 0 without either): a tile's extra halo."""
+        plan's factor, or its gate towards O, which the model reads over its own 3 x 3
+        neighbourhood: ``spec.blend_model.toward_weight``; 0 without either): a tile's extra
+        halo."""
         if self.local is None:
             return LOCAL_REACH if self.toward_original else 0
         return self.local.reach

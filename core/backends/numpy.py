@@ -4,6 +4,7 @@ import numpy as np
 
 from ..contract import to_rgba_float
 from ..spec import BlendModel, from_working_space, recover_working, to_working_space
+from ..spec.blend_model import toward_weight
 from ..spec.local_plan import LocalStrength, encoded_colour, strength_map
 from ..spec.ramp_lookup import ramp_lookup
 from ..tiling import DEFAULT_TILES, halo_for
@@ -67,12 +68,12 @@ class NumpyBackend:
         prior = plan.pure_colours
         if factor is not None and prior is not None and prior.drawn_only:
             gate = plan.local.gate(self._encoded, prior.ink_gate, prior.ink_span)
-        # A smoothing filter's drawn edges move towards O by the gate of drawn content: the
-        # pure colours' gate where they have one, else the regions' weight or the drawn ink
-        # (read even without a local plan).
+        # A smoothing filter's drawn edges move towards O by the gate of drawn content around
+        # them: the pure colours' gate where they have one, else the regions' weight or the
+        # drawn ink (read even without a local plan).
         toward = None
         if plan.toward_original:
-            toward = gate if gate is not None else LocalStrength.gate(self._encoded, True)
+            toward = toward_weight(gate if gate is not None else LocalStrength.gate(self._encoded, True))
         recovered, model = _recover_in_strips(self._original, self._filtered, plan, factor, gate, toward)
         self._result = from_working_space(recovered, self._filtered_rgba, filtered_work=self._filtered,
                                           **self._space)

@@ -22,6 +22,21 @@ const float SPREAD_TIE = 1e-3;        // a start further by less is a tie: the f
 const float SPREAD_TIE_FLOOR = 1e-6;
 const float UNTOUCHED_EXTREMES = 0.1;  // F moved the extremes by at most this: untouched_factor applies
 const float KEPT_EXTREMES = 0.1;       // ... and towards O applies (toward_original)
+#if TOWARD_ORIGINAL
+// The weight of O's own colour towards O: the largest gate of drawn content over the pixel's
+// 3 x 3 neighbourhood (twin: toward_weight in aarecovery/spec/blend_model.py). Read where the
+// edge strength is above 0 only: O and F (or a ridge of O) differ within a pixel there, so
+// every neighbour lies in a block the fit lists (margins of 2: blocks.active_mask and
+// pure_colour_mask), where the local plan's last pass wrote the gate.
+float toward_weight(ivec2 p, ivec2 size) {
+    float weight = 0.0;
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+            weight = max(weight, texelFetch(strength_factor, clamp_to_image(p + ivec2(dx, dy), size), 0).g);
+    return weight;
+}
+#endif
+
 #if BEST_PAIR
 // Where the principal line misses the centre by more than BEST_PAIR_MISS sigma_d, the pair of
 // neighbours that explains it best (twin: best_pair in aarecovery/spec/blend_model.py).
@@ -243,7 +258,7 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
     // A smoothing filter's drawn edges move towards O by the gate of drawn content, last
     // (toward_original in aarecovery/spec/blend_model.py).
     // Only where F kept the extremes (KEPT_EXTREMES): a colour it changed is not O's.
-    float g = (edge > 0.0 && moved_extremes <= KEPT_EXTREMES) ? texelFetch(strength_factor, p, 0).g : 0.0;
+    float g = (edge > 0.0 && moved_extremes <= KEPT_EXTREMES) ? toward_weight(p, size) : 0.0;
     beta = (1.0 - g) * beta;
     vec4 data = (1.0 - beta) * f[0] + g * (c[0] - f[0]);  // exactly F where F is O
 #else
