@@ -177,6 +177,23 @@ def test_a_smoothed_drawing_moves_towards_o_where_the_filter_kept_its_colours():
     assert towards > 0.88 and towards > without + 0.1, (towards, without)
 
 
+def test_a_smoothed_drawing_moves_towards_o_below_the_repair_ratio():
+    """The map in sRGB under OpenCV's bilateral filter: the model's repairs are no larger than
+    its own error there (a repair-to-error ratio below MIN_REPAIR_TO_ERROR, which keeps F),
+    but the filter kept O's colours, so the drawn edges move towards O, which needs no model:
+    most of F's edge error goes (0.955 at 96 px)."""
+    from aarecovery.plan.model_error import MIN_REPAIR_TO_ERROR
+    case = _serif_under("cv-bilateral", width=96, family="maps")
+    band = edge_band(case.original, case.filtered, case.reference)
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        plan = engine.plan()
+        assert plan.toward_original and f"< {MIN_REPAIR_TO_ERROR:g})" in plan.reason, plan.reason
+        engine.run(plan)
+        reduction = error_reduction(engine.result(), case.filtered, case.reference, band)
+    assert reduction > 0.9, reduction
+
+
 def test_towards_o_leaves_a_changed_colour_to_the_model():
     """Where F moved an extreme by more than KEPT_EXTREMES (a colour replacement, which the
     smoothing test reads as smoothing too) the weight of O is 0: O's pixel would bring the

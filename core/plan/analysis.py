@@ -48,7 +48,8 @@ colour lines better), then takes the first of these exits that applies, each nam
    calibrated strength, as for a table.
 9. ``NEIGHBOURHOOD_HARD_EDGED_KEPT``: a neighbourhood filter on hard-edged content whose
    repairs are no larger than the model's own error (a stricter bar for a smoothing filter on
-   a compressed O): F is kept.
+   a compressed O): F is kept, unless a smoothing filter kept a clean O's colours, whose drawn
+   edges then move towards O as in 11.
 10. ``COLOUR_MAP_HARD_EDGED``: a colour map of all three channels at once (a palette
     quantiser) on hard-edged content, told from neighbourhood filters by a higher share
     (``colour_map.HARD_EDGED_COLOUR_MAP_SHARE``): full strength, or from a JPEG the
@@ -89,7 +90,7 @@ from .compression import (COMPRESSED_HARD_EDGED_BLEND_SPACE, COMPRESSED_REPAIR_T
                           COMPRESSED_SHARPENED_STRENGTH, COMPRESSED_SMOOTHED_BLEND_SPACE, COMPRESSED_SMOOTHED_STRENGTH,
                           GRID_MARGIN, compression_evidence, hidden_compression)
 from .fit_blocks import pure_colour_blocks_pay
-from .flat_colours import flat_colour_prior
+from .flat_colours import flat_colour_prior, flat_kept_share
 from .forcing import forcing_advice
 from .hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screentone_drawing
 from .linearity import AFFINE_SHARE, affine_share
@@ -101,7 +102,8 @@ from .paper_grain import (GRAINED_NEIGHBOURHOOD_STRENGTH, SHARPENED_GRAIN_BLEND_
 from .pointwise import POINTWISE_SHARE, fit_pointwise
 from .pure_colours import COMPRESSED_LUMA_PURITY, pure_colour_prior
 from .ramp import ramp_table_of
-from .smoothing import SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, UNTOUCHED_SPAN, contrast_ratio, keeps_flat_colours
+from .smoothing import (BELOW_RATIO_KEPT_SHARE, SMOOTHED_CONTRAST, SMOOTHED_STRENGTH, UNTOUCHED_SPAN, contrast_ratio,
+                        keeps_flat_colours)
 from .texture import is_grey, is_textured
 
 __all__ = ["PairAnalysis", "analyse", "analyse_pair", "analysis_crop"]
@@ -633,7 +635,13 @@ def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterat
     # one (see COMPRESSED_REPAIR_TO_ERROR).
     smoothing = contrast_ratio(o, f, edges) < SMOOTHED_CONTRAST
     needed = COMPRESSED_REPAIR_TO_ERROR if compression.compressed and smoothing else MIN_REPAIR_TO_ERROR
-    if ratio < needed:
+    # Below the ratio the model's repairs are no larger than its error, but where a smoothing
+    # filter keeps a clean O's colours as they were (BELOW_RATIO_KEPT_SHARE) the drawn edges
+    # move towards O (below), which needs no model. Tuning half, the map in sRGB under
+    # OpenCV's bilateral filter (ratio 1.91): 0 -> 0.955 of its edge error; no other case of
+    # either half moved.
+    below = ratio < needed
+    if below and not _moves_towards_original_below_the_ratio(smoothing, compression, o, f, edges):
         return PairAnalysis(space, 0.0, f"neighbourhood filter on hard-edged content, but the repairs would be "
                                         f"no larger than the model's own error (ratio {ratio:.2f} < "
                                         f"{needed:g}" + (f" above {compression.describe()}" if compression.compressed
@@ -655,7 +663,7 @@ def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterat
     # for a table of one key: serif at q 98 (linear light) 0.405 -> 0.643, the one JPEG case
     # of the tuning half that reads as a hard-edged colour map.
     colour_map = fit_colour_map(o, f, edges)
-    if colour_map.consistency >= HARD_EDGED_COLOUR_MAP_SHARE:
+    if colour_map.consistency >= HARD_EDGED_COLOUR_MAP_SHARE and not below:
         why = (f"point-wise colour map ({colour_map.consistency:.3f} of edges match, repair-to-error ratio "
                f"{ratio:.1f}) on hard-edged content")
         if compression.compressed:
@@ -699,7 +707,8 @@ def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterat
     if prior is not None and smoothing:
         prior = replace(prior, noise_contrast=float(grain.contrast))
     pure = f", pure colours of thin features ({kept})" if prior is not None else ""
-    why = f"neighbourhood filter on hard-edged content (repair-to-error ratio {ratio:.1f})"
+    why = (f"neighbourhood filter on hard-edged content (repair-to-error ratio {ratio:.1f}"
+           + (f" < {needed:g}" if below else "") + ")")
     # Where it keeps O's colours (the prior: its flat areas and colour lines; every flat pixel)
     # in a clean O (not a JPEG's, whose noise the filter smoothed away), the drawn content's
     # edges move towards O (plan/smoothing.py).
@@ -770,6 +779,16 @@ def _moves_towards_original(smoothing, flat_prior, compression, o, f):
     keeps O's colours (the flat-colour prior exists and no flat pixel moved by more than
     ``smoothing.FLAT_COLOUR_MOVE``) and O is not compressed."""
     return bool(smoothing and flat_prior is not None and not compression.compressed and keeps_flat_colours(o, f))
+
+
+def _moves_towards_original_below_the_ratio(smoothing, compression, o, f, edges):
+    """:func:`_moves_towards_original` as the exits after the repair-to-error ratio decide it
+    (not on a coarse paper grain, whose smoothing takes its own exit without the move), and F
+    keeps O's flat colours as they were (``smoothing.BELOW_RATIO_KEPT_SHARE``)."""
+    grain = paper_grain(o)
+    if not smoothing or grain.coarse or flat_kept_share(o, f) < BELOW_RATIO_KEPT_SHARE:
+        return False
+    return _moves_towards_original(smoothing, flat_colour_prior(o, f, edges, grain)[0], compression, o, f)
 
 
 def _repair_to_error(o_rgba, f_rgba, linear_input, space, sigma_d, sigma_e):

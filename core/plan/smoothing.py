@@ -55,7 +55,7 @@ from ..colour import LUMA_WEIGHTS, largest_channel
 from ..spec.local_plan import flat_pixels
 
 __all__ = ["contrast_ratio", "keeps_flat_colours", "SMOOTHED_CONTRAST", "SMOOTHED_STRENGTH", "UNTOUCHED_SPAN",
-           "FLAT_COLOUR_MOVE"]
+           "FLAT_COLOUR_MOVE", "BELOW_RATIO_KEPT_SHARE"]
 
 #: F smooths (rather than sharpens) when its Laplacian at O's edges is below this multiple of
 #: O's. Only smoothing averages the strokes away: under an unsharp mask the screentone manga
@@ -93,6 +93,14 @@ UNTOUCHED_SPAN = 6.0 / 255
 #: its old colour back (3.65 dB lost). Chosen after that held-out result, at twice the
 #: smoothing filters' largest move.
 FLAT_COLOUR_MOVE = 32.0 / 255
+#: Where the model's repairs are no larger than its own error (the repair-to-error ratio
+#: below ``model_error.MIN_REPAIR_TO_ERROR``, which keeps F), towards O needs F to keep this
+#: share of O's deep flat pixels as they were (``flat_colours.flat_kept_share``): a colour
+#: map read as smoothing there keeps fewer (a saturation change by 1.1 on the pie charts
+#: 0.76, hue changes and colour to grey 0.00-0.94), and towards O would bring its old
+#: colours back at every edge. Tuning half, the one case below the ratio that moves (the map
+#: in sRGB under OpenCV's bilateral filter) keeps 1.00.
+BELOW_RATIO_KEPT_SHARE = 0.99
 
 
 def _laplacian(encoded):
