@@ -195,10 +195,12 @@ def test_a_smoothed_drawing_moves_towards_o_below_the_repair_ratio():
 
 
 def test_towards_o_leaves_a_changed_colour_to_the_model():
-    """Where F moved an extreme by more than KEPT_EXTREMES (a colour replacement, which the
-    smoothing test reads as smoothing too) the weight of O is 0: O's pixel would bring the
-    old colour back. Where F kept both extremes it is the given weight, and beta shrinks by
-    it; where F is O the step gives F exactly."""
+    """Where F moved an extreme off O's colour line between the extremes by more than
+    KEPT_EXTREMES (a colour replacement, which the smoothing test reads as smoothing too) the
+    weight of O is 0: O's pixel would bring the old colour back. Where F kept both extremes,
+    or moved one along that line (a smoothing filter mixing a thin line with its
+    surroundings), it is the given weight, and beta shrinks by it; where F is O the step
+    gives F exactly."""
     from aarecovery.spec import fit_blend_model, jacobi_step
     from aarecovery.spec.blend_model import KEPT_EXTREMES
     width = 9
@@ -209,8 +211,10 @@ def test_towards_o_leaves_a_changed_colour_to_the_model():
     softened[:, 4, :3] = 0.5  # the edge pixel softened, the flat colours kept
     swapped = softened.copy()
     swapped[:, :4, 0] += 2 * KEPT_EXTREMES  # the dark colour replaced
+    mixed = softened.copy()
+    mixed[:, 3, :3] += 3 * KEPT_EXTREMES  # the dark side mixed towards the light one, along the line
     weight = np.full((5, width), 0.75, np.float32)
-    for filtered, expected in ((softened, 0.75), (swapped, 0.0)):
+    for filtered, expected in ((softened, 0.75), (swapped, 0.0), (mixed, 0.75)):
         plain = fit_blend_model(original, filtered, 0.1, 0.01)
         model = fit_blend_model(original, filtered, 0.1, 0.01, toward=weight)
         assert model.edge[2, 4] > 0 and model.toward[2, 4] == pytest.approx(expected), expected

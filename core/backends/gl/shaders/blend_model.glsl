@@ -21,13 +21,22 @@ const float FAINT = 1e-30;
 const float SPREAD_TIE = 1e-3;        // a start further by less is a tie: the first wins
 const float SPREAD_TIE_FLOOR = 1e-6;
 const float UNTOUCHED_EXTREMES = 0.1;  // F moved the extremes by at most this: untouched_factor applies
-const float KEPT_EXTREMES = 0.1;       // ... and towards O applies (toward_original)
+const float KEPT_EXTREMES = 0.1;       // F at the extremes this near O's line: towards O applies
 #if TOWARD_ORIGINAL
 // The weight of O's own colour towards O: the largest gate of drawn content over the pixel's
 // 3 x 3 neighbourhood (twin: toward_weight in aarecovery/spec/blend_model.py). Read where the
 // edge strength is above 0 only: O and F (or a ridge of O) differ within a pixel there, so
 // every neighbour lies in a block the fit lists (margins of 2: blocks.active_mask and
 // pure_colour_mask), where the local plan's last pass wrote the gate.
+// How far `colour` lies from the segment between O's extremes c_a and c_b (twin: _off_the_line).
+float off_the_line(vec4 colour, vec4 c_a, vec4 c_b) {
+    vec4 span = c_a - c_b;
+    float span_sq = dot(span, span);
+    float t = span_sq > TINY ? dot(colour - c_b, span) / span_sq : 0.0;
+    vec4 off = colour - (c_b + clamp(t, 0.0, 1.0) * span);
+    return sqrt(dot(off, off));
+}
+
 float toward_weight(ivec2 p, ivec2 size) {
     float weight = 0.0;
     for (int dy = -1; dy <= 1; ++dy)
@@ -225,6 +234,11 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
         }
     }
 #endif
+#if TOWARD_ORIGINAL
+    // How far F at the extremes lies from O's colour line between them, before pure colours
+    // replace their F (toward_original).
+    float off_line = max(off_the_line(f_a, c_a, c_b), off_the_line(f_b, c_a, c_b));
+#endif
     // The extremes' offsets as base-3 digits (x and y of a, then of b); jacobi.glsl decodes them.
     float code = float((offset_a.x + 1) + 3 * (offset_a.y + 1) + 9 * (offset_b.x + 1) + 27 * (offset_b.y + 1));
 #if PURE_COLOURS
@@ -257,8 +271,9 @@ BlendFit fit_blend_model(ivec2 p, ivec2 size) {
 #if TOWARD_ORIGINAL
     // A smoothing filter's drawn edges move towards O by the gate of drawn content, last
     // (toward_original in aarecovery/spec/blend_model.py).
-    // Only where F kept the extremes (KEPT_EXTREMES): a colour it changed is not O's.
-    float g = (edge > 0.0 && moved_extremes <= KEPT_EXTREMES) ? toward_weight(p, size) : 0.0;
+    // Only where F kept the extremes on O's colour line (KEPT_EXTREMES): a colour it changed is
+    // not O's; along the line is what a smoothing filter moves them.
+    float g = (edge > 0.0 && off_line <= KEPT_EXTREMES) ? toward_weight(p, size) : 0.0;
     beta = (1.0 - g) * beta;
     vec4 data = (1.0 - beta) * f[0] + g * (c[0] - f[0]);  // exactly F where F is O
 #else
