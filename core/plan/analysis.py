@@ -785,8 +785,10 @@ def _moves_towards_original_below_the_ratio(smoothing, compression, o, f, edges)
     """:func:`_moves_towards_original` as the exits after the repair-to-error ratio decide it
     (not on a coarse paper grain, whose smoothing takes its own exit without the move), and F
     keeps O's flat colours as they were (``smoothing.BELOW_RATIO_KEPT_SHARE``)."""
+    if not smoothing or compression.compressed or flat_kept_share(o, f) < BELOW_RATIO_KEPT_SHARE:
+        return False
     grain = paper_grain(o)
-    if not smoothing or grain.coarse or flat_kept_share(o, f) < BELOW_RATIO_KEPT_SHARE:
+    if grain.coarse:
         return False
     return _moves_towards_original(smoothing, flat_colour_prior(o, f, edges, grain)[0], compression, o, f)
 

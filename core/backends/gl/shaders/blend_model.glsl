@@ -23,11 +23,6 @@ const float SPREAD_TIE_FLOOR = 1e-6;
 const float UNTOUCHED_EXTREMES = 0.1;  // F moved the extremes by at most this: untouched_factor applies
 const float KEPT_EXTREMES = 0.1;       // F at the extremes this near O's line: towards O applies
 #if TOWARD_ORIGINAL
-// The weight of O's own colour towards O: the largest gate of drawn content over the pixel's
-// 3 x 3 neighbourhood (twin: toward_weight in aarecovery/spec/blend_model.py). Read where the
-// edge strength is above 0 only: O and F (or a ridge of O) differ within a pixel there, so
-// every neighbour lies in a block the fit lists (margins of 2: blocks.active_mask and
-// pure_colour_mask), where the local plan's last pass wrote the gate.
 // How far `colour` lies from the segment between O's extremes c_a and c_b (twin: _off_the_line).
 float off_the_line(vec4 colour, vec4 c_a, vec4 c_b) {
     vec4 span = c_a - c_b;
@@ -37,6 +32,11 @@ float off_the_line(vec4 colour, vec4 c_a, vec4 c_b) {
     return sqrt(dot(off, off));
 }
 
+// The weight of O's own colour towards O: the largest gate of drawn content over the pixel's
+// 3 x 3 neighbourhood (twin: toward_weight in aarecovery/spec/blend_model.py). Read where the
+// edge strength is above 0 only: O and F (or a ridge of O) differ within a pixel there, so
+// every neighbour lies in a block the fit lists (margins of 2: blocks.active_mask and
+// pure_colour_mask), where the local plan's last pass wrote the gate.
 float toward_weight(ivec2 p, ivec2 size) {
     float weight = 0.0;
     for (int dy = -1; dy <= 1; ++dy)
