@@ -39,6 +39,8 @@ TWINS = {
     ("local_plan.glsl", "INK_REPEATS"): local_plan.INK_REPEATS,
     ("local_plan.glsl", "INK_NEAR_SPAN"): local_plan.INK_NEAR_SPAN,
     ("local_plan.glsl", "INK_DARK"): local_plan.INK_DARK,
+    ("local_plan.glsl", "KEPT_CONTRAST_LOW"): local_plan.KEPT_CONTRAST_LOW,
+    ("local_plan.glsl", "KEPT_CONTRAST_HIGH"): local_plan.KEPT_CONTRAST_HIGH,
     ("local_plan.glsl", "INK_TIE"): local_plan.INK_TIE,
     ("local_plan.glsl", "INK_SHARE_LOW"): local_plan.INK_SHARE_LOW,
     ("local_plan.glsl", "INK_SHARE_HIGH"): local_plan.INK_SHARE_HIGH,

@@ -107,7 +107,8 @@ class Plan:
     toward_original : bool
         A smoothing filter that keeps O's colours (``aarecovery.plan.smoothing``): every Jacobi
         step moves the edge pixels of the drawn content towards O's own colour by the local
-        plan's gate, its regions' weight or drawn ink (``aarecovery.spec.blend_model.toward_original``).
+        plan's gate, its regions' weight or drawn ink, over a photo the ink where F kept O's
+        contrast (``aarecovery.spec.blend_model.toward_original``).
     forcing : Forcing or None
         Where the safe default keeps F: whether forcing a repair may help, and why or what
         it risks (``aarecovery.plan.forcing``).

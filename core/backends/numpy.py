@@ -71,9 +71,15 @@ class NumpyBackend:
         # A smoothing filter's drawn edges move towards O by the gate of drawn content around
         # them: the pure colours' gate where they have one, else the regions' weight or the
         # drawn ink (read even without a local plan).
+        # Where that gate leaves the drawn ink out (text over a photo), the ink moves too where
+        # F kept its contrast (LocalStrength.kept_ink).
         toward = None
         if plan.toward_original:
-            toward = toward_weight(gate if gate is not None else LocalStrength.gate(self._encoded, True))
+            weight = gate if gate is not None else LocalStrength.gate(self._encoded, True)
+            if gate is not None and not prior.ink_gate:
+                filtered_encoded = encoded_colour(self._filtered_rgba, self._space["linear_input"])
+                weight = np.maximum(weight, LocalStrength.kept_ink(self._encoded, filtered_encoded))
+            toward = toward_weight(weight)
         recovered, model = _recover_in_strips(self._original, self._filtered, plan, factor, gate, toward)
         self._result = from_working_space(recovered, self._filtered_rgba, filtered_work=self._filtered,
                                           **self._space)

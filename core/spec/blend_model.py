@@ -468,7 +468,9 @@ def toward_weight(gate):
     Parameters
     ----------
     gate : ndarray of float32, shape (H, W)
-        The gate of drawn content (``aarecovery.spec.local_plan.LocalStrength.gate``).
+        The gate of drawn content (``aarecovery.spec.local_plan.LocalStrength.gate``; where
+        the pure colours' gate leaves the drawn ink out, the larger of it and
+        ``LocalStrength.kept_ink``, the ink where F kept O's contrast).
 
     Returns
     -------
@@ -489,8 +491,9 @@ def toward_original(model, original, filtered, weight):
     Each Jacobi step becomes ``beta' (alpha R[p_a] + (1 - alpha) R[p_b]) + (1 - beta' - g) F
     + g O`` with ``beta' = (1 - g) beta``: ``(1 - g)`` times the paper's step plus ``g O``.
     ``g`` is `weight` (:func:`toward_weight`: the local plan's gate of drawn content, flat
-    regions read as drawn or a stroke's ink recurring exactly nearby, its largest over the
-    pixel's 3 x 3 neighbourhood) at the
+    regions read as drawn or a stroke's ink recurring exactly nearby, where the pure colours'
+    gate leaves the ink out (text over a photo) the ink only where F kept O's contrast
+    (``LocalStrength.kept_ink``), its largest over the pixel's 3 x 3 neighbourhood) at the
     pixels with an edge strength above 0 where F's colour at both extremes of the model lies
     within :data:`KEPT_EXTREMES` of O's colour line between them (working space): where F moved
     one off that line it changed a colour (a colour replacement, which the smoothing test also

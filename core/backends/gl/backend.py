@@ -71,7 +71,7 @@ _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("mode
                  "edge_strength": ("edge", 0), "strength": ("strength", 0)}
 # The textures made when first needed: (components, dtype); "result" has F's.
 _WORK_TEXTURES = {"original_work": (4, "f4"), "filtered_work": (4, "f4"), "model": (4, "f4"), "edge": (1, "f4"),
-                  "local_flat": (1, "f4"), "local_rows": (1, "f4"), "strength_factor": (2, "f4"), "strength": (1, "f4"),
+                  "local_flat": (1, "f4"), "local_rows": (1, "f4"), "strength_factor": (4, "f4"), "strength": (1, "f4"),
                   "jacobi_constant": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4"), "wakes": (1, "f1")}
 _RESULT_BITS = {np.dtype(np.uint8): 8, np.dtype(np.uint16): 16}
 # The storage-buffer binding of the fit's live-block flags (live_blocks.glsl).
@@ -465,11 +465,14 @@ class GLBackend:
             if local:
                 drawn_only = prior is not None and prior.drawn_only
                 gated = drawn_only and prior.ink_gate
-                # Towards O reads the gate too: with the drawn ink where no prior's gate decides.
+                # Towards O reads the gate too: with the drawn ink where no prior's gate decides,
+                # and where the prior's gate leaves the ink out, the ink where F kept O's contrast.
                 self._local_factor(local_plan, None if maps else (lists, "original" if pure_gate else active),
                                    ink_gate=gated or (plan.toward_original and not drawn_only),
                                    ink_span=prior.ink_span if gated else FLAT_SPAN,
-                                   for_beta=prior is None and not plan.toward_original)
+                                   for_beta=prior is None and not plan.toward_original,
+                                   kept_ink=plan.toward_original and plan.local is not None and drawn_only
+                                   and not gated)
             if active == "pure_colours" and pure_gate:
                 lists, split = self._pure_colour_lists(lists, RIDGE_NOISE_MARGIN * prior.ridge_noise, pure_gate)
             if maps:
@@ -557,7 +560,7 @@ class GLBackend:
         lists, ridges, plain = (self._lists[name] for name in parts)
         return lists, (ridges, plain)
 
-    def _local_factor(self, local, blocks=None, ink_gate=False, ink_span=FLAT_SPAN, for_beta=False):
+    def _local_factor(self, local, blocks=None, ink_gate=False, ink_span=FLAT_SPAN, for_beta=False, kept_ink=False):
         """The local plan's factor of beta for the loaded O, once per pair and plan (three passes).
 
         `blocks`: ``(lists, name)``, the block lists of the run, when only the fit reads the
@@ -571,16 +574,19 @@ class GLBackend:
         `ink_span` (``PureColourPrior.ink_span``). `for_beta`: with `blocks`, the factor only
         multiplies beta (no pure colours, no move towards O): where F is flat around a pixel,
         whose beta is 0, the last pass counts no drawn ink (``FACTOR_FOR_BETA`` in
-        ``local_plan.glsl``), and the factor there is not the specification's.
+        ``local_plan.glsl``), and the factor there is not the specification's. `kept_ink`: the
+        third channel holds the drawn ink's weight towards O where F kept O's contrast
+        (``LocalStrength.kept_ink``; else 0).
         """
         for_beta = bool(for_beta and blocks is not None)
-        if self._factor_for in ((local, ink_gate, ink_span, False, None),
-                                (local, ink_gate, ink_span, for_beta, blocks and blocks[1])):
+        kept_ink = bool(kept_ink)
+        if self._factor_for in ((local, ink_gate, ink_span, False, None, kept_ink),
+                                (local, ink_gate, ink_span, for_beta, blocks and blocks[1], kept_ink)):
             return
         defines = {"LOCAL_ENCODE": int(self._linear["original"]), "INK_BY_LUMA": int(ink_gate and ink_span > FLAT_SPAN),
                    "REGION_GATHER": int(self.gather_region_sums)}
         last_inputs = {"local_input": self._work("local_rows"), "original_image": self._textures["original"]}
-        if for_beta:
+        if for_beta or kept_ink:
             last_inputs["filtered_image"] = self._textures["filtered"]
         steps = (({"original_image": self._textures["original"]}, "local_flat", "dilated"),
                  ({"local_input": self._work("local_flat")}, "local_rows", "dilated"),
@@ -588,11 +594,11 @@ class GLBackend:
         for number, (inputs, output, list_name) in enumerate(steps, 1):
             where = {} if blocks is None else {"blocks": blocks[0], "list_name": list_name}
             uniforms = {"textured": local.textured, "ink_gate_span": float(ink_span)}
-            beta_only = ({"FACTOR_FOR_BETA": int(for_beta), "DRAWN_INK": int(local.drawn_ink), "INK_GATE": int(ink_gate)}
-                         if number == 3 else {})
+            beta_only = ({"FACTOR_FOR_BETA": int(for_beta), "DRAWN_INK": int(local.drawn_ink), "INK_GATE": int(ink_gate),
+                          "KEPT_INK": int(kept_ink)} if number == 3 else {})
             self._run_pass("local_plan", inputs, [self._work(output)], uniforms=uniforms,
                           defines={**defines, **beta_only, "LOCAL_PASS": number}, **where)
-        self._factor_for = (local, ink_gate, ink_span, for_beta, blocks and blocks[1])
+        self._factor_for = (local, ink_gate, ink_span, for_beta, blocks and blocks[1], kept_ink)
         # Gated pure colours listed their blocks by this factor's gate.
         self._classified -= {name for name in self._classified if isinstance(name, tuple) and name[2]}
 
@@ -600,9 +606,9 @@ class GLBackend:
         """The strength map of the maps: the plan's strength times the local factor (read back)."""
         factor = None
         if plan.local is not None:
-            both = np.empty(self._key[0][::-1] + (2,), np.float32)
-            self._work("strength_factor").read_into(both)
-            factor = both[..., 0]
+            channels = np.empty(self._key[0][::-1] + (4,), np.float32)
+            self._work("strength_factor").read_into(channels)
+            factor = channels[..., 0]
         self._work("strength").write(strength_map(plan, factor, self._key[0][::-1]))
 
     def _transfer_table(self, prior):

@@ -33,15 +33,19 @@ float off_the_line(vec4 colour, vec4 c_a, vec4 c_b) {
 }
 
 // The weight of O's own colour towards O: the largest gate of drawn content over the pixel's
-// 3 x 3 neighbourhood (twin: toward_weight in aarecovery/spec/blend_model.py). Read where the
+// 3 x 3 neighbourhood, or of the kept ink (local_plan.glsl's third channel, 0 where the local
+// plan did not read it) (twin: toward_weight in aarecovery/spec/blend_model.py). Read where the
 // edge strength is above 0 only: O and F (or a ridge of O) differ within a pixel there, so
 // every neighbour lies in a block the fit lists (margins of 2: blocks.active_mask and
 // pure_colour_mask), where the local plan's last pass wrote the gate.
 float toward_weight(ivec2 p, ivec2 size) {
     float weight = 0.0;
-    for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-            weight = max(weight, texelFetch(strength_factor, clamp_to_image(p + ivec2(dx, dy), size), 0).g);
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            vec4 read = texelFetch(strength_factor, clamp_to_image(p + ivec2(dx, dy), size), 0);
+            weight = max(weight, max(read.g, read.b));
+        }
+    }
     return weight;
 }
 #endif

@@ -5,7 +5,7 @@
 #include "local_plan.glsl"
 
 #if LOCAL_PASS == 3
-layout(rg32f, binding = 0) uniform writeonly image2D value;  // the factor and the regions' weight
+layout(rgba32f, binding = 0) uniform writeonly image2D value;  // the factor, the regions' weight, the kept ink
 #else
 layout(r32f, binding = 0) uniform writeonly image2D value;
 #endif
@@ -13,5 +13,5 @@ layout(r32f, binding = 0) uniform writeonly image2D value;
 void main() {
     ivec2 p = block_origin() + ivec2(gl_LocalInvocationID.xy);
     if (!inside_image(p)) return;
-    imageStore(value, p, vec4(local_plan(p, image_size), 0.0, 1.0));
+    imageStore(value, p, vec4(local_plan(p, image_size), 1.0));
 }

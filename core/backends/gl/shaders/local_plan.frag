@@ -15,5 +15,5 @@ void main() {
 #else
     ivec2 size = textureSize(local_input, 0);
 #endif
-    value = vec4(local_plan(ivec2(gl_FragCoord.xy), size), 0.0, 1.0);
+    value = vec4(local_plan(ivec2(gl_FragCoord.xy), size), 1.0);
 }

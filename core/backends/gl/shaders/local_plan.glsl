@@ -10,6 +10,8 @@
 // aarecovery/spec/local_plan.py. With
 // LOCAL_ENCODE the uploaded O is linear light and is sRGB-encoded first. With
 // FACTOR_FOR_BETA, pass 3 counts no drawn ink where F is flat around the pixel (below).
+// With KEPT_INK, pass 3 also gives the drawn ink's weight towards O where the gate leaves the
+// ink out, times how fully F kept O's contrast (LocalStrength.kept_ink, kept_contrast).
 // Needs colour.glsl.
 
 // Pass 3's switches, off in passes 1 and 2 (which compile ink_weight but never call it).
@@ -18,6 +20,15 @@
 #endif
 #ifndef INK_GATE
 #define INK_GATE 0
+#endif
+#ifndef KEPT_INK
+#define KEPT_INK 0
+#endif
+// The gate's count of the ink: for the gate, or for the kept ink towards O.
+#if INK_GATE || KEPT_INK
+#define GATE_INK 1
+#else
+#define GATE_INK 0
 #endif
 
 const float FLAT_SPAN = 0.5 / 255.0;
@@ -37,12 +48,14 @@ const int INK_GATE_REPEATS = 2;
 const float INK_LUMA_SATURATION = 90.5 / 255.0;
 const float INK_LUMA_DARK = 31.5 / 255.0;
 const float LUMA_TIE = 0.00005 / 255.0;
+const float KEPT_CONTRAST_LOW = 0.9;
+const float KEPT_CONTRAST_HIGH = 1.05;
 
 uniform sampler2D original_image;  // O as uploaded (passes 1 and 3)
 uniform sampler2D local_input;     // the previous pass's output (passes 2 and 3)
 uniform float textured;            // the factor in textured regions (pass 3)
 uniform float ink_gate_span;       // within what the gate's ink recurs: FLAT_SPAN, wider on a JPEG (pass 3)
-#if FACTOR_FOR_BETA
+#if FACTOR_FOR_BETA || KEPT_INK
 uniform sampler2D filtered_image;  // F as uploaded (pass 3)
 #endif
 
@@ -86,7 +99,7 @@ vec2 ink_weight(ivec2 p, ivec2 size, bool needed) {
     // One read of the square counts both extremes' repeats (the counts are exact integers).
     ivec2 equal = ivec2(0);
     ivec2 near = ivec2(0);
-#if INK_GATE
+#if GATE_INK
     ivec2 gate_equal = ivec2(0);
     ivec2 gate_near = ivec2(0);
 #endif
@@ -106,7 +119,7 @@ vec2 ink_weight(ivec2 p, ivec2 size, bool needed) {
             equal += is_equal;
             near += (1 - is_equal) * is_near;
 #endif
-#if INK_GATE
+#if GATE_INK
 #if INK_BY_LUMA
             vec2 gate_distance = mix(distance, abs(vec2(dot(c, LUMA)) - ink_luma) - LUMA_TIE, by_luma);
 #else
@@ -126,7 +139,7 @@ vec2 ink_weight(ivec2 p, ivec2 size, bool needed) {
         // The strength's test, then the gate's (fewer recurrences, within its span).
         bool bright = max(ink.r, max(ink.g, ink.b)) > INK_DARK;
         bvec2 drawn = bvec2(DRAWN_INK != 0 && bright && 2 * near[side] <= equal[side] && equal[side] >= INK_REPEATS,
-#if INK_GATE
+#if GATE_INK
                             bright && 2 * gate_near[side] <= gate_equal[side] && gate_equal[side] >= INK_GATE_REPEATS);
 #else
                             false);
@@ -175,10 +188,39 @@ float region_sum(ivec2 p, ivec2 size) {
 }
 #endif
 
+#if KEPT_INK
+// The largest channel's span of `image`'s 3 x 3 neighbourhood (borders replicated),
+// sRGB-encoded with LOCAL_ENCODE.
+float encoded_span(sampler2D image, ivec2 p, ivec2 size) {
+    vec3 lowest = vec3(2.0);
+    vec3 highest = vec3(-1.0);
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            vec3 c = texelFetch(image, clamp(p + ivec2(dx, dy), ivec2(0), size - 1), 0).rgb;
+#if LOCAL_ENCODE
+            c = linear_to_srgb(c);
+#endif
+            lowest = min(lowest, c);
+            highest = max(highest, c);
+        }
+    }
+    vec3 span = highest - lowest;
+    return max(span.r, max(span.g, span.b));
+}
+
+// How fully F kept O's contrast around p, 0 to 1 (twin: kept_contrast).
+float kept_contrast(ivec2 p, ivec2 size) {
+    float original_span = encoded_span(original_image, p, size);
+    float ratio = original_span > 0.0 ? encoded_span(filtered_image, p, size) / original_span : 0.0;
+    float t = clamp((ratio - KEPT_CONTRAST_LOW) / (KEPT_CONTRAST_HIGH - KEPT_CONTRAST_LOW), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}
+#endif
+
 // Passes 1 and 2: their value in .x; pass 3: the factor and the gate of pure colours on drawn
 // content only (LocalStrength.gate: the regions' weight, with ink_gate the larger of it and
-// the drawn ink).
-vec2 local_plan(ivec2 p, ivec2 size) {
+// the drawn ink), and with KEPT_INK the kept ink towards O (LocalStrength.kept_ink; else 0).
+vec3 local_plan(ivec2 p, ivec2 size) {
 #if LOCAL_PASS == 1
     // Flat: the 3 x 3 neighbourhood (borders replicated) spans at most FLAT_SPAN in every
     // channel, and is not black.
@@ -194,9 +236,9 @@ vec2 local_plan(ivec2 p, ivec2 size) {
     vec3 span = brightest - lowest;
     bool flat_ = max(span.r, max(span.g, span.b)) <= FLAT_SPAN
                  && max(brightest.r, max(brightest.g, brightest.b)) > FLAT_SPAN;
-    return vec2(flat_ ? 1.0 : 0.0, 0.0);
+    return vec3(flat_ ? 1.0 : 0.0, 0.0, 0.0);
 #elif LOCAL_PASS == 2
-    return vec2(region_sum(p, size), 0.0);
+    return vec3(region_sum(p, size), 0.0, 0.0);
 #else
     float count = region_sum(p, size);
     ivec2 low = max(p - REGION_RADIUS, ivec2(0));
@@ -221,9 +263,14 @@ vec2 local_plan(ivec2 p, ivec2 size) {
     needed = !filtered_flat;
 #endif
     // The ink is at most 1: at a full region weight it changes neither value.
-    vec2 ink = (DRAWN_INK != 0 || INK_GATE != 0) && region < 1.0 ? ink_weight(p, size, needed) : vec2(0.0);
+    vec2 ink = (DRAWN_INK != 0 || GATE_INK != 0) && region < 1.0 ? ink_weight(p, size, needed) : vec2(0.0);
     float weight = DRAWN_INK != 0 ? max(region, ink.x) : region;
     float gate = INK_GATE != 0 ? max(region, ink.y) : region;
-    return vec2(textured + (1.0 - textured) * weight, gate);
+#if KEPT_INK
+    float kept_ink = max(region, ink.y) * kept_contrast(p, size);
+#else
+    float kept_ink = 0.0;
+#endif
+    return vec3(textured + (1.0 - textured) * weight, gate, kept_ink);
 #endif
 }
