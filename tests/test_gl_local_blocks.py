@@ -49,7 +49,7 @@ def test_the_factor_is_the_specifications_where_the_fit_reads_it(bars_over_photo
         _, numpy_maps = aarecovery.recover(original, filtered, backend="numpy", linear=linear, return_maps=True)
         with aarecovery.Engine("gl", gl_path=gl_path) as engine:
             aarecovery.recover(original, filtered, engine=engine, linear=linear)
-            channels = np.empty(filtered.shape[:2] + (4,), np.float32)
+            channels = np.empty(filtered.shape[:2] + (2,), np.float32)
             with engine.context:
                 engine._impl._textures["strength_factor"].read_into(channels)
             factor = channels[..., 0]

@@ -174,7 +174,7 @@ def test_gpu_flags_and_result_are_the_specifications(gl_path, name, original, fi
             grid = lists.grid
             flags = np.frombuffer(lists.flags.read(), np.uint32)[:grid[0] * grid[1]].reshape(grid[1], grid[0])
             wakes = _read(impl._work("wakes"), 1, np.uint8)[..., 0]
-            gate = _read(impl._work("strength_factor"), 4, np.float32)[..., 1] if gated else None
+            gate = _read(impl._work("strength_factor"), 2, np.float32)[..., 1] if gated else None
     height, width = work_o.shape[:2]
     tile_o, tile_f = _uploaded(original), _uploaded(filtered)  # one tile
     fitted = active_mask(tile_o)

@@ -71,9 +71,14 @@ _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("mode
                  "edge_strength": ("edge", 0), "strength": ("strength", 0)}
 # The textures made when first needed: (components, dtype); "result" has F's.
 _WORK_TEXTURES = {"original_work": (4, "f4"), "filtered_work": (4, "f4"), "model": (4, "f4"), "edge": (1, "f4"),
-                  "local_flat": (1, "f4"), "local_rows": (1, "f4"), "strength_factor": (4, "f4"), "strength": (1, "f4"),
+                  "local_flat": (1, "f4"), "local_rows": (1, "f4"), "strength_factor": (2, "f4"), "kept_factor": (4, "f4"), "strength": (1, "f4"),
                   "jacobi_constant": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4"), "wakes": (1, "f1")}
 _RESULT_BITS = {np.dtype(np.uint8): 8, np.dtype(np.uint16): 16}
+
+
+def _factor_texture(kept_ink):
+    """The local plan's output: its factor and gate, and with `kept_ink` the kept ink too."""
+    return "kept_factor" if kept_ink else "strength_factor"
 # The storage-buffer binding of the fit's live-block flags (live_blocks.glsl).
 _LIVE_FLAGS = 6
 # The seen-ink test's compiled lengths (INK_SLOTS in pure_colours.glsl): few programs, each
@@ -439,8 +444,13 @@ class GLBackend:
         # without a local plan gets one whose factor is exactly 1.
         local_plan = plan.local if plan.local is not None or not plan.toward_original else _GATE_ONLY
         local = local_plan is not None
+        drawn_only = prior is not None and prior.drawn_only
+        gated = drawn_only and prior.ink_gate
+        # Where the prior's gate leaves the drawn ink out, towards O reads the ink where F kept
+        # O's contrast: a third channel (LocalStrength.kept_ink), in a texture of its own.
+        kept_ink = plan.toward_original and plan.local is not None and drawn_only and not gated
         if local:
-            sources["strength_factor"] = self._work("strength_factor")
+            sources["strength_factor"] = self._work(_factor_texture(kept_ink))
         defines = {**self._defines, "PURE_COLOURS": int(prior is not None), "LOCAL_STRENGTH": int(local),
                    "TOWARD_ORIGINAL": int(plan.toward_original), "BEST_PAIR": int(plan.best_pair),
                    "JACOBI_CONSTANT": int(prior is not None or plan.toward_original)}
@@ -463,16 +473,11 @@ class GLBackend:
             if active == "pure_colours" and not pure_gate:
                 lists, split = self._pure_colour_lists(lists, RIDGE_NOISE_MARGIN * prior.ridge_noise, pure_gate)
             if local:
-                drawn_only = prior is not None and prior.drawn_only
-                gated = drawn_only and prior.ink_gate
-                # Towards O reads the gate too: with the drawn ink where no prior's gate decides,
-                # and where the prior's gate leaves the ink out, the ink where F kept O's contrast.
+                # Towards O reads the gate too: with the drawn ink where no prior's gate decides.
                 self._local_factor(local_plan, None if maps else (lists, "original" if pure_gate else active),
                                    ink_gate=gated or (plan.toward_original and not drawn_only),
                                    ink_span=prior.ink_span if gated else FLAT_SPAN,
-                                   for_beta=prior is None and not plan.toward_original,
-                                   kept_ink=plan.toward_original and plan.local is not None and drawn_only
-                                   and not gated)
+                                   for_beta=prior is None and not plan.toward_original, kept_ink=kept_ink)
             if active == "pure_colours" and pure_gate:
                 lists, split = self._pure_colour_lists(lists, RIDGE_NOISE_MARGIN * prior.ridge_noise, pure_gate)
             if maps:
@@ -553,7 +558,8 @@ class GLBackend:
             wakes = self._work("wakes")
             self._run_pass("flag_pure_colour_blocks", inputs, [wakes], blocks=original_lists, list_name="active",
                           uniforms={"ridge_floor": key[1]}, defines=self._defines)
-            gate = self._work("strength_factor") if gated else None
+            # The local plan's factor was made first (its gate in the second channel).
+            gate = self._work(_factor_texture(self._factor_for[5])) if gated else None
             self._timed("pure colour blocks", lambda: self._classifier.list_near_wakes(
                 wakes, original_lists, lists, (ridges, plain), gate))
             self._classified.add(key)
@@ -574,9 +580,10 @@ class GLBackend:
         `ink_span` (``PureColourPrior.ink_span``). `for_beta`: with `blocks`, the factor only
         multiplies beta (no pure colours, no move towards O): where F is flat around a pixel,
         whose beta is 0, the last pass counts no drawn ink (``FACTOR_FOR_BETA`` in
-        ``local_plan.glsl``), and the factor there is not the specification's. `kept_ink`: the
+        ``local_plan.glsl``), and the factor there is not the specification's. `kept_ink`: a
         third channel holds the drawn ink's weight towards O where F kept O's contrast
-        (``LocalStrength.kept_ink``; else 0).
+        (``LocalStrength.kept_ink``), in a texture of four channels (``kept_factor``) rather
+        than ``strength_factor``'s two.
         """
         for_beta = bool(for_beta and blocks is not None)
         kept_ink = bool(kept_ink)
@@ -590,7 +597,7 @@ class GLBackend:
             last_inputs["filtered_image"] = self._textures["filtered"]
         steps = (({"original_image": self._textures["original"]}, "local_flat", "dilated"),
                  ({"local_input": self._work("local_flat")}, "local_rows", "dilated"),
-                 (last_inputs, "strength_factor", "active"))
+                 (last_inputs, _factor_texture(kept_ink), "active"))
         for number, (inputs, output, list_name) in enumerate(steps, 1):
             where = {} if blocks is None else {"blocks": blocks[0], "list_name": list_name}
             uniforms = {"textured": local.textured, "ink_gate_span": float(ink_span)}
@@ -606,8 +613,9 @@ class GLBackend:
         """The strength map of the maps: the plan's strength times the local factor (read back)."""
         factor = None
         if plan.local is not None:
-            channels = np.empty(self._key[0][::-1] + (4,), np.float32)
-            self._work("strength_factor").read_into(channels)
+            texture = self._work(_factor_texture(self._factor_for[5]))
+            channels = np.empty(self._key[0][::-1] + (texture.components,), np.float32)
+            texture.read_into(channels)
             factor = channels[..., 0]
         self._work("strength").write(strength_map(plan, factor, self._key[0][::-1]))
 

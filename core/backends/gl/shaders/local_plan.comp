@@ -4,8 +4,10 @@
 #include "colour.glsl"
 #include "local_plan.glsl"
 
-#if LOCAL_PASS == 3
+#if LOCAL_PASS == 3 && KEPT_INK
 layout(rgba32f, binding = 0) uniform writeonly image2D value;  // the factor, the regions' weight, the kept ink
+#elif LOCAL_PASS == 3
+layout(rg32f, binding = 0) uniform writeonly image2D value;  // the factor and the regions' weight
 #else
 layout(r32f, binding = 0) uniform writeonly image2D value;
 #endif
