@@ -30,6 +30,9 @@ runs the same passes on each tile: 1, 2 and the sums of 3 along rows, then along
    it in pass 3, from O).
 5. :meth:`LocalStrength.factor`: the factor of the confidence ``beta``, from the textured
    strength (photo regions) to 1 (hard-edged regions or drawn ink), by the larger weight.
+6. Under a smoothing filter over a photo, :meth:`LocalStrength.kept_ink`: the drawn ink's
+   weight towards O, by how fully F kept O's contrast there (:func:`kept_contrast`; the GL
+   twin's pass 3 reads F too and writes it in a third channel).
 
 Thresholds chosen on the tuning half of the mixed scenes (shares 0.05-0.25, 0.1-0.3 and
 0.15-0.35, radii 6, 8 and 16: graphics 0.596-0.609, photo 0.360-0.367 of the edge error
