@@ -71,14 +71,10 @@ _MAP_CHANNELS = {"alpha": ("model", 0), "beta": ("model", 1), "residual": ("mode
                  "edge_strength": ("edge", 0), "strength": ("strength", 0)}
 # The textures made when first needed: (components, dtype); "result" has F's.
 _WORK_TEXTURES = {"original_work": (4, "f4"), "filtered_work": (4, "f4"), "model": (4, "f4"), "edge": (1, "f4"),
-                  "local_flat": (1, "f4"), "local_rows": (1, "f4"), "strength_factor": (2, "f4"), "kept_factor": (4, "f4"), "strength": (1, "f4"),
-                  "jacobi_constant": (4, "f4"), "iterate_a": (4, "f4"), "iterate_b": (4, "f4"), "wakes": (1, "f1")}
+                  "local_flat": (1, "f4"), "local_rows": (1, "f4"), "strength_factor": (2, "f4"),
+                  "kept_factor": (4, "f4"), "strength": (1, "f4"), "jacobi_constant": (4, "f4"),
+                  "iterate_a": (4, "f4"), "iterate_b": (4, "f4"), "wakes": (1, "f1")}
 _RESULT_BITS = {np.dtype(np.uint8): 8, np.dtype(np.uint16): 16}
-
-
-def _factor_texture(kept_ink):
-    """The local plan's output: its factor and gate, and with `kept_ink` the kept ink too."""
-    return "kept_factor" if kept_ink else "strength_factor"
 # The storage-buffer binding of the fit's live-block flags (live_blocks.glsl).
 _LIVE_FLAGS = 6
 # The seen-ink test's compiled lengths (INK_SLOTS in pure_colours.glsl): few programs, each
@@ -153,6 +149,12 @@ class _PendingReadback:
 
     def wait(self):
         return self._backend._finish_readback(self._buffer, self._array)
+
+
+def _factor_texture(kept_ink):
+    """The local plan's output texture: its factor and gate (two channels), and with
+    `kept_ink` the kept ink too (four)."""
+    return "kept_factor" if kept_ink else "strength_factor"
 
 
 class GLBackend:
