@@ -14,6 +14,7 @@ from aarecovery.plan.mixed_content import DRAWN_REGION_SHARE, drawn_only
 from aarecovery.spec.sobel import gradient_magnitude
 from aarecovery.spec import recover_working, to_working_space
 from aarecovery.spec.local_plan import LocalStrength, flat_share, hard_edged_weight, ink_weight
+from aarecovery.spec.pure_colours import MIN_CONTRAST
 from test_local_plan import banner_over_photo  # noqa: F401 (a fixture)
 from test_local_plan import _BANNER
 
@@ -77,7 +78,7 @@ def test_the_gate_fades_the_extension_in_and_leaves_the_photo_the_papers(banner_
     prior, textured = plan.pure_colours, plan.local.textured
     shape = work_o.shape[:2]
 
-    def run(gate, gated=True):
+    def run(gate, gated=True, prior=prior):
         factor = np.full(shape, textured + (1 - textured) * gate, np.float32)
         return recover_working(work_o, work_f, plan.sigma_d, plan.sigma_e, plan.iterations, plan.strength, prior,
                                plan.blend_space, factor, gate=np.full(shape, gate, np.float32) if gated else None)
@@ -90,12 +91,22 @@ def test_the_gate_fades_the_extension_in_and_leaves_the_photo_the_papers(banner_
                                          None, plan.blend_space, factor)
     np.testing.assert_allclose(model.beta, paper_model.beta, atol=1e-6)
     np.testing.assert_allclose(photo, paper, atol=1e-6)
-    # Gate 1 (a drawing): the prior as on hard-edged content.
-    full, full_model = run(1.0)
+    # Gate 1 (a drawing): the prior as on hard-edged content, but on this lossless O only
+    # against a flat colour or towards a pure colour O shows (PureColourPrior.backed_or_seen).
+    assert prior.backed_or_seen
     ungated, ungated_model = run(1.0, gated=False)
+    full, full_model = run(1.0)
     assert full_model.pure_a.sum() + full_model.pure_b.sum() > 20
-    np.testing.assert_array_equal(full_model.pure_a, ungated_model.pure_a)
-    np.testing.assert_allclose(full, ungated, atol=1e-5)
+    for gated_side, ungated_side in ((full_model.pure_a, ungated_model.pure_a), (full_model.pure_b, ungated_model.pure_b)):
+        assert not (gated_side & ~ungated_side).any()
+    assert full_model.pure_a.sum() + full_model.pure_b.sum() < ungated_model.pure_a.sum() + ungated_model.pure_b.sum()
+    # Without that rule (a noise contrast at the least contrast tested anyway: the same
+    # extremes tested), exactly the prior as on hard-edged content.
+    unbacked = dataclasses.replace(prior, noise_contrast=MIN_CONTRAST)
+    assert not unbacked.backed_or_seen and unbacked.min_contrast == prior.min_contrast
+    unbacked_full, unbacked_model = run(1.0, prior=unbacked)
+    np.testing.assert_array_equal(unbacked_model.pure_a, ungated_model.pure_a)
+    np.testing.assert_allclose(unbacked_full, ungated, atol=1e-5)
     # Between: the same extremes extended, the pure colours that share of the way.
     _, faint = run(1e-6)
     _, half = run(0.5)
@@ -111,14 +122,22 @@ def test_the_gate_fades_the_extension_in_and_leaves_the_photo_the_papers(banner_
     assert extended.any() and (gate[extended] > 0).all() and (gate == 0).any()
 
 
-@pytest.mark.filterwarnings("ignore::aarecovery.errors.TileSizeWarning")
-def test_gated_pure_colours_agree_on_both_backends_and_tiled(banner_over_photo, gl_path):
-    case = banner_over_photo
+def gl_agrees_with_numpy(case, gl_path):
+    """R of `case` on the NumPy backend and on GL (`gl_path`), checked equal within 1e-5, and
+    GL's plan: (numpy_result, gl_result, plan)."""
     numpy_result = aarecovery.recover(case.original, case.filtered, backend="numpy")
     with aarecovery.Engine("gl", gl_path=gl_path) as engine:
         gl_result = aarecovery.recover(case.original, case.filtered, engine=engine)
-        assert engine.last_plan.pure_colours.drawn_only
+        plan = engine.last_plan
     np.testing.assert_allclose(gl_result, numpy_result, atol=1e-5)
+    return numpy_result, gl_result, plan
+
+
+@pytest.mark.filterwarnings("ignore::aarecovery.errors.TileSizeWarning")
+def test_gated_pure_colours_agree_on_both_backends_and_tiled(banner_over_photo, gl_path):
+    case = banner_over_photo
+    numpy_result, gl_result, plan = gl_agrees_with_numpy(case, gl_path)
+    assert plan.pure_colours.drawn_only
     for tile in (24, 40):
         tiled = aarecovery.recover(case.original, case.filtered, backend="gl", gl_path=gl_path, tile_size=tile)
         np.testing.assert_array_equal(tiled, gl_result)

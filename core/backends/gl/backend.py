@@ -460,6 +460,7 @@ class GLBackend:
             defines.update(self._pure_colour_defines(prior))
             # Pure colours on drawn content only, gated by the local plan's regions' weight.
             defines["PURE_GATE"] = int(local and prior.drawn_only)
+            defines["BACKED_OR_SEEN"] = int(local and prior.backed_or_seen)
         if ramp is not None:
             if prior is not None and (ramp.key != prior.key or not np.array_equal(ramp.table, prior.table)):
                 raise ValueError(f"the ramp lookup's table (key {ramp.key!r}) is not the pure colours' (key "

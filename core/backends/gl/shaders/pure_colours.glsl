@@ -29,6 +29,12 @@ uniform float luma_purity;         // an extreme whose luma is within this of a 
 #ifndef PURE_GATE
 #define PURE_GATE 0
 #endif
+// BACKED_OR_SEEN: 1 (with PURE_GATE, on a lossless O): a partial colour is extended only
+//            against a flat colour of O or towards a pure colour O shows
+//            (PureColourPrior.backed_or_seen)
+#ifndef BACKED_OR_SEEN
+#define BACKED_OR_SEEN 0
+#endif
 // NO_EXTENSION: 1: no extreme is extended (the blocks the pure colours' listing found no
 //            possible ridge near: backend._pure_colour_lists), the same model as where every test fails
 #ifndef NO_EXTENSION
@@ -166,7 +172,7 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
         vec3 miss = far.rgb - palette[i] * far.a;
         far_pure = far_pure || !(miss.r * miss.r + miss.g * miss.g + miss.b * miss.b >= tolerance_sq)
                    || abs(miss.r * LUMA.r + miss.g * LUMA.g + miss.b * LUMA.b) < luma_purity;
-#if CLAMP_ENDS
+#if CLAMP_ENDS || BACKED_OR_SEEN
         vec3 near_miss = near.rgb - palette[i] * near.a;
         near_pure = near_pure || near_miss.r * near_miss.r + near_miss.g * near_miss.g
                                  + near_miss.b * near_miss.b < tolerance_sq
@@ -220,7 +226,13 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
 #if !TO_CUBE
     else return result;
 #endif
-    if (!(reach > MIN_REACH)) {
+#if BACKED_OR_SEEN
+    // Over a lossless photo: against a flat colour of O, or towards a pure colour O shows.
+    bool tested = true;
+#else
+    bool tested = !(reach > MIN_REACH);
+#endif
+    if (tested) {
         // The extreme is the ink itself, unless O shows the pure colour: a flat colour
         // stopped the extension, or the cube's point is one of O's inks.
         bool seen = nearest < 1e5 && nearest <= cube_reach;
@@ -231,7 +243,10 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
             seen = seen || max(max(miss.r, miss.g), miss.b) <= INK_TOLERANCE;
         }
 #endif
-        if (!seen || !(reach > SHORT_REACH)) return result;
+        if (!(reach > MIN_REACH) && (!seen || !(reach > SHORT_REACH))) return result;
+#if BACKED_OR_SEEN
+        if (!seen && !near_pure) return result;
+#endif
     }
 #if PURE_GATE
     reach = 1.0 + gate * (reach - 1.0);
