@@ -211,7 +211,8 @@ def test_real_tools_smoothing_of_text_over_a_photo_takes_pure_colours():
     from aarecovery.lab.metrics import edge_band, error_reduction
     from test_realtools import require_tool
     require_tool(realtools.TOOL_FILTERS["cv-smoothing"].tool)
-    suite = dataclasses.replace(realtools.REAL_FULL, families=("poster",), filters=("cv-smoothing",))
+    suite = dataclasses.replace(realtools.REAL_FULL, families=("poster",), filters=("cv-smoothing",),
+                                spaces={"poster": ("linear",)})
     (case,) = realtools.build_cases(suite, "tune", jpeg=False)
     engine = aarecovery.Engine("numpy")
     recovered = aarecovery.recover(case.original, case.filtered, engine=engine)

@@ -102,7 +102,7 @@ def test_flat_areas_are_where_fs_3x3_neighbourhood_is_one_8_bit_colour():
 def test_cases_carry_regions_and_paper():
     require_tool("opencv")
     suite = realtools.RealToolsSuite("marks", ("poster", "memo", "manga"), ("cv-threshold",), 24,
-                                     {"memo": ("srgb",), "manga": ("srgb",)})
+                                     {"poster": ("linear",), "memo": ("srgb",), "manga": ("srgb",)})
     cases = realtools.build_cases(suite, "tune")
     assert len(cases) == 6
     for case in cases:
@@ -189,7 +189,7 @@ def test_summary_prints_regions_haze_and_neighbourhood_filters():
         require_tool(name)
     suite = realtools.RealToolsSuite("regions", ("banner", "letter", "comicstrip"),
                                      ("cv-edge-preserving", "im-threshold-55"), 32,
-                                     {"letter": ("srgb",), "comicstrip": ("srgb",)}, (85,))
+                                     {"banner": ("linear",), "letter": ("srgb",), "comicstrip": ("srgb",)}, (85,))
     results, missing_tools, _ = run_realtools(suite, "heldout", peers=False)
     assert not missing_tools and len(results) == 3 * 2 * 2
     mixed = [r for r in results if r.kind == "mixed"]

@@ -57,6 +57,21 @@ def test_a_maps_edges_vote_for_its_space_where_three_colours_meet(space):
     assert not means_tell_srgb(residuals)
 
 
+@pytest.mark.parametrize("space", ["linear", "srgb"])
+def test_text_and_chrome_over_a_photo_tell_its_space(space):
+    # Text and chrome over a photo (the poster over the coffee photo, the screenshot's window
+    # over the grey camera photo): the photo's texture ties the whole window's means and does
+    # not vote, so the sRGB scenes read as linear light; their drawn pixels' edges tell
+    # (plan.blend_space).
+    from aarecovery.plan.mixed_content import drawn_at
+    for family in ("poster", "screenshot"):
+        original = _map(space, family=family)
+        assert choose_blend_space(rgba(original))[0] == "linear", family
+        chosen, residuals = choose_blend_space(rgba(original), drawn=lambda rows, cols: drawn_at(original, rows, cols))
+        assert chosen == space, (family, residuals)
+        assert analyse(rgba(original), rgba(original ** 2)).blend_space == space, family
+
+
 def test_a_jpegs_edges_do_not_vote():
     # Compression noise fits sRGB values better whatever the space (plan.blend_space): the
     # star burst antialiased in linear light, saved at q 75, would vote for sRGB values.

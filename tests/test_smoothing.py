@@ -313,6 +313,54 @@ def test_a_filter_that_moves_a_flat_colour_does_not_move_towards_o():
     assert plan.untouched_span > 0 and not plan.toward_original, plan.reason
 
 
+def test_a_colour_map_that_moves_a_flat_colour_a_little_does_not_move_towards_o():
+    """A hue change moves a greyish flat colour by less than FLAT_COLOUR_MOVE, but all of it
+    to one new colour: that turns towards O off; a smoothing filter's moves, which vary with
+    the distance to an edge, do not."""
+    from aarecovery.plan.smoothing import FLAT_COLOUR_MAP_MOVE, FLAT_COLOUR_MOVE, keeps_flat_colours
+    from aarecovery.spec.local_plan import flat_pixels
+    case = _serif_under("cv-bilateral")
+    original, filtered = case.original, case.filtered.copy()
+    assert keeps_flat_colours(original, filtered)
+    flat = flat_pixels(original)
+    levels = np.rint(original * 255).astype(int)
+    colours, counts = np.unique(levels[flat], axis=0, return_counts=True)
+    colour = colours[np.argmax(counts)]
+    of_colour = np.flatnonzero(flat & (levels == colour).all(-1))
+    assert of_colour.size >= 16
+    shift = np.where(colour > 127, -1, 1).astype(np.float32) * 2 * FLAT_COLOUR_MAP_MOVE
+    assert 2 * FLAT_COLOUR_MAP_MOVE < FLAT_COLOUR_MOVE
+    moved = filtered.reshape(-1, 3).copy()
+    moved[of_colour[:of_colour.size // 3]] = colour / 255 + shift  # a third: beside edges
+    assert keeps_flat_colours(original, moved.reshape(filtered.shape))
+    by_distance = np.linspace(0.25, 1.5, of_colour.size, dtype=np.float32)[:, None]
+    moved[of_colour] = colour / 255 + shift * by_distance  # all of it, by varying amounts
+    assert keeps_flat_colours(original, moved.reshape(filtered.shape))
+    moved[of_colour] = colour / 255 + shift  # the whole colour to one new colour
+    assert not keeps_flat_colours(original, moved.reshape(filtered.shape))
+
+
+def test_a_hue_change_on_a_screenshot_keeps_its_title_bar():
+    """GEGL's hue-chroma on the screenshot (sRGB) reads as smoothing over a textured image
+    with drawn regions; it moved the blue-grey title bar by 18/255 and towards O brought the
+    old colour back (0.98 of the text's edge error added)."""
+    import dataclasses
+
+    from aarecovery.lab import realtools
+    from test_realtools import require_tool
+    require_tool("gegl")
+    suite = dataclasses.replace(realtools.REAL_FULL, families=("screenshot",), filters=("gegl-hue-chroma",),
+                                spaces={"screenshot": ("srgb",)})
+    (case,) = realtools.build_cases(suite, "tune", jpeg=False)
+    band = edge_band(case.original, case.filtered, case.reference)
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        plan = engine.plan()
+        assert not plan.toward_original, plan.reason
+        engine.run(plan)
+        assert error_reduction(engine.result(), case.filtered, case.reference, band) > -0.05, plan.reason
+
+
 def test_dense_line_work_moves_towards_o_by_its_drawn_ink():
     """The star burst's spokes leave few flat regions, but their ink recurs exactly: the
     weight of O is the drawn ink's there too (OpenCV's bilateral in sRGB at 64 px: 0.81,

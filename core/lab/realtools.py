@@ -19,7 +19,9 @@ Drawings (:mod:`aarecovery.lab.drawings`, comics from :mod:`aarecovery.lab.comic
 scans of text (:mod:`aarecovery.lab.overlays`) are rendered at ``k = 8`` in both
 antialiasing spaces; photos (``core/data/photo_*``, see ``core/data/LICENSE.md``) are their
 own scene at full resolution, box-downsampled by ``k = 4`` in linear light (they are camera
-images); mixed content is a photo's scene with text and graphics drawn over it, at ``k = 4``.
+images); mixed content is a photo's scene with text and graphics drawn over it, at ``k = 4``,
+in both spaces (a poster, banner or screenshot is made in an editor or a browser, whose
+downscales and text run in sRGB values as often as in linear light).
 A mixed case carries its regions (text/graphics and photo, from the overlay drawn on the
 scene), a scan its paper background (no ink within a pixel), so that the evaluation can
 report each region and the haze a repair paints on the paper.
@@ -66,7 +68,7 @@ _SCAN_QUALITIES = (75, 80, 85, 90, 95)
 _DRAWING_K = 8
 _PHOTO_K = 4
 #: Kinds whose scenes are camera images (antialiased in linear light only).
-_CAMERA_KINDS = ("photo", "mixed")
+_CAMERA_KINDS = ("photo",)
 
 
 @dataclass(frozen=True)
@@ -269,7 +271,7 @@ class RealToolsSuite:
     width : int
         O's width for drawings (photos keep their size: the crop over ``k``).
     spaces : dict of str to tuple of str
-        Antialiasing spaces per drawing family (photos: linear only).
+        Antialiasing spaces per drawing, scan or mixed family (photos: linear only).
     jpeg_qualities : tuple of int
         Each PNG case gets one JPEG case, at the quality picked from these by its name.
     """
@@ -317,8 +319,8 @@ class RealToolsSuite:
 _ALL_FAMILIES = tuple(FAMILIES)
 _ALL_FILTERS = tuple(TOOL_FILTERS)
 
-#: Every family in both spaces (photos and mixed content linear), every tool filter, O 96
-#: px wide: about 740 PNG cases and as many JPEG ones.
+#: Every family in both spaces (photos linear), every tool filter, O 96
+#: px wide: about 930 PNG cases and as many JPEG ones.
 REAL_FULL = RealToolsSuite("realtools", _ALL_FAMILIES, _ALL_FILTERS, 96,
                            {name: ("linear", "srgb") for name, f in FAMILIES.items() if f.kind not in _CAMERA_KINDS})
 #: Two drawings, two photos and one mixed scene per half, one space per drawing, O 64 px
@@ -333,7 +335,7 @@ REAL_QUICK = RealToolsSuite("realtools-quick", ("maps", "starburst", "text", "co
                                                 "towers", "rocket", "banner"),
                             tuple(f for f in _ALL_FILTERS if f not in _QUICK_LEAVES_OUT), 64,
                             {"maps": ("srgb",), "starburst": ("linear",), "hatching": ("srgb",),
-                             "pies": ("linear",)}, (85, 95))
+                             "pies": ("linear",), "poster": ("linear",), "banner": ("linear",)}, (85, 95))
 
 
 def render_family(name, width):

@@ -95,7 +95,7 @@ from .forcing import forcing_advice
 from .hatching import HATCHED_SHARE, HATCHED_STRENGTH, hatched_share, is_screentone_drawing
 from .linearity import AFFINE_SHARE, affine_share
 from .lowpass import fit_lowpass
-from .mixed_content import COMPRESSED_INK_SPAN, MIXED_DRAWN_SHARE, drawn_only, drawn_share
+from .mixed_content import COMPRESSED_INK_SPAN, MIXED_DRAWN_SHARE, drawn_at, drawn_only, drawn_share
 from .model_error import MIN_REPAIR_TO_ERROR, repair_to_error_ratio
 from .paper_grain import (GRAINED_NEIGHBOURHOOD_STRENGTH, SHARPENED_GRAIN_BLEND_SPACE, SHARPENED_GRAIN_PURE_BLEND_SPACE,
                           grain_edge_scale, paper_grain)
@@ -317,7 +317,8 @@ def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterat
     transfer_ahead = ahead.submit(fit_pointwise, o, f, edges)
     compression = compression_evidence(o, quantization)
     readings.append(compression)
-    space, residuals = choose_blend_space(o_rgba, linear_input, lossless=not compression.compressed)
+    space, residuals = choose_blend_space(o_rgba, linear_input, lossless=not compression.compressed,
+                                          drawn=lambda rows, cols: drawn_at(o, rows, cols))
     fit = residuals[space]
     lowpass, kernel_residual, _ = lowpass_ahead.result()
     if lowpass:

@@ -36,7 +36,7 @@ import numpy as np
 
 from ..spec.local_plan import FLAT_SPAN, LocalStrength, ink_weight_at
 
-__all__ = ["drawn_share", "drawn_only", "MIXED_DRAWN_SHARE", "DRAWN_REGION_SHARE", "COMPRESSED_INK_SPAN"]
+__all__ = ["drawn_at", "drawn_share", "drawn_only", "MIXED_DRAWN_SHARE", "DRAWN_REGION_SHARE", "COMPRESSED_INK_SPAN"]
 
 #: The share of a textured window's edge pixels that must read as drawn for its drawn
 #: regions to be repaired under a neighbourhood filter (F kept in the photo): between the
@@ -78,6 +78,19 @@ DRAWN_REGION_SHARE = 0.01
 COMPRESSED_INK_SPAN = 2.5 / 255
 
 
+def drawn_at(encoded, rows, cols):
+    """bool ``(K,)``: whether the local plan reads each pixel ``(rows[k], cols[k])`` of O as
+    drawn (text, graphics, ink: its factor at a textured strength of 0 over one half).
+
+    Parameters
+    ----------
+    encoded : ndarray of float32, shape (H, W, 3)
+        O's sRGB-encoded colour (the analysis window).
+    rows, cols : ndarray of int, shape (K,)
+    """
+    return LocalStrength(0.0).factor_at(encoded, rows, cols) > np.float32(0.5)
+
+
 def drawn_share(encoded, edges):
     """The share of the edge pixels that the local plan reads as drawn (text, graphics, ink).
 
@@ -93,7 +106,8 @@ def drawn_share(encoded, edges):
         0 without edge pixels.
     """
     # The summary line's share of text and drawings, with a textured strength of 0.
-    return LocalStrength(0.0).hard_edged_share(encoded, edges)
+    rows, cols = np.nonzero(edges)
+    return float(np.mean(drawn_at(encoded, rows, cols))) if rows.size else 0.0
 
 
 def drawn_only(prior, encoded, edges, ink=False, ink_span=FLAT_SPAN):

@@ -93,6 +93,25 @@ UNTOUCHED_SPAN = 6.0 / 255
 #: its old colour back (3.65 dB lost). Chosen after that held-out result, at twice the
 #: smoothing filters' largest move.
 FLAT_COLOUR_MOVE = 32.0 / 255
+#: ... and moves none of O's flat colours as a whole, as a colour map does: every flat pixel
+#: of the colour (at least :data:`FLAT_COLOUR_PIXELS` of them; all but a share of
+#: :data:`FLAT_COLOUR_STRAYS`) within one 8-bit level of one new colour, which lies more than
+#: this from O's. A point-wise map sends each pixel of a colour to the same colour, and a hue
+#: change moves a greyish one by little: GEGL's hue-chroma moved the sRGB screenshot's
+#: blue-grey title bar by 18/255 (all 211 of its flat pixels), under :data:`FLAT_COLOUR_MOVE`,
+#: and towards O brought its old colour back (0.98 of its text's edge error added, where the
+#: repair without the move stays within 0.03 dB of F). A smoothing filter moves a flat
+#: region's pixels by how near an edge they lie: on the tuning half the nearest to one new
+#: colour were the icons' under G'MIC's bilateral filter (95% within a level, moved by 2/255);
+#: hue changes and grey conversions moved their colours by 7.4/255 (the poster) to 126/255,
+#: every pixel alike.
+FLAT_COLOUR_MAP_MOVE = 6.0 / 255
+#: Fewer flat pixels of a colour do not tell how it moved.
+FLAT_COLOUR_PIXELS = 16
+#: The share of a colour's flat pixels that may lie off its one new colour (8-bit rounding).
+FLAT_COLOUR_STRAYS = 0.01
+# "Within one 8-bit level", with room for float32 rounding of k / 255.
+_ONE_LEVEL = 1.5 / 255
 #: Where the model's repairs are no larger than its own error (the repair-to-error ratio
 #: below ``model_error.MIN_REPAIR_TO_ERROR``, which keeps F), towards O needs F to keep this
 #: share of O's deep flat pixels as they were (``flat_colours.flat_kept_share``): a colour
@@ -130,7 +149,8 @@ def contrast_ratio(original, filtered, edges):
 
 
 def keeps_flat_colours(original, filtered):
-    """Whether F moved no pixel of O's flat regions by more than :data:`FLAT_COLOUR_MOVE`.
+    """Whether F moved no pixel of O's flat regions by more than :data:`FLAT_COLOUR_MOVE`
+    and none of O's flat colours as a whole to another (:data:`FLAT_COLOUR_MAP_MOVE`).
 
     Parameters
     ----------
@@ -140,4 +160,18 @@ def keeps_flat_colours(original, filtered):
     flat = flat_pixels(original)
     if not flat.any():
         return True
-    return bool(largest_channel(np.abs(filtered[flat] - original[flat])).max() <= np.float32(FLAT_COLOUR_MOVE))
+    was, now = original[flat], filtered[flat]
+    if largest_channel(np.abs(now - was)).max() > np.float32(FLAT_COLOUR_MOVE):
+        return False
+    levels = np.rint(was * 255).astype(np.int64)
+    _, colour_of, counts = np.unique(levels[:, 0] << 16 | levels[:, 1] << 8 | levels[:, 2], return_inverse=True,
+                                     return_counts=True)
+    order = np.argsort(colour_of.ravel(), kind="stable")
+    for colour, pixels in zip(np.split(order, np.cumsum(counts)[:-1]), counts):
+        if pixels < FLAT_COLOUR_PIXELS:
+            continue
+        moved_to = np.median(now[colour], axis=0)
+        on_it = np.mean(largest_channel(np.abs(now[colour] - moved_to)) <= np.float32(_ONE_LEVEL))
+        if on_it >= 1 - FLAT_COLOUR_STRAYS and np.abs(moved_to - was[colour[0]]).max() > FLAT_COLOUR_MAP_MOVE:
+            return False
+    return True
