@@ -15,6 +15,7 @@ TWINS = {
     ("pure_colours.glsl", "PALETTE_TOLERANCE"): pure_colours.PALETTE_TOLERANCE,
     ("pure_colour_blocks.glsl", "LINE_TOLERANCE"): pure_colours.LINE_TOLERANCE,
     ("pure_colours.glsl", "RIDGE_MARGIN"): pure_colours.RIDGE_MARGIN,
+    ("pure_colours.glsl", "INK_LINE_TOLERANCE"): pure_colours.INK_LINE_TOLERANCE,
     ("pure_colours.glsl", "RIDGE_NOISE_MARGIN"): pure_colours.RIDGE_NOISE_MARGIN,
     ("pure_colours.glsl", "EXPLAIN_TOLERANCE"): pure_colours.EXPLAIN_TOLERANCE,
     ("pure_colours.glsl", "ON_LINE_TOLERANCE"): pure_colours.ON_LINE_TOLERANCE,

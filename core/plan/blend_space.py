@@ -148,8 +148,9 @@ def choose_blend_space(original_rgba, linear_input=False, lossless=True, drawn=N
     # the screenshot under JET 0.400 -> 0.658; its photo regions under OpenCV's gamma and JET
     # no longer worse than F, by up to 1.94 dB before, nor the whole under Pillow's
     # autocontrast, 0.79 dB before: its affine map is seen in sRGB values), 7 down (the
-    # screenshot under the two equalizations 0.589 -> 0.374 and 0.543 -> 0.440: its title
-    # bar's text takes its pure colours in linear light only; the poster under Pillow's
+    # screenshot under the two equalizations 0.589 -> 0.374 and 0.543 -> 0.440: the grey
+    # photo's flat greys stopped its title's extension in sRGB values; since
+    # spec.pure_colours.INK_LINE_TOLERANCE 0.544 and 0.543; the poster under Pillow's
     # autocontrast 0.000 -> -0.014). Below the share, a JPEG drawing at q 98 whose grid is not
     # seen (the star burst in linear light, 20 of 2634) votes with its noise, and a JPEG's
     # drawn pixels do not decide: its noise fits sRGB values better whatever the space.

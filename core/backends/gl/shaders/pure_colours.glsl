@@ -61,6 +61,7 @@ uniform float luma_purity;         // an extreme whose luma is within this of a 
 
 const float PALETTE_TOLERANCE = 0.03;
 const float RIDGE_MARGIN = 0.1001;
+const float INK_LINE_TOLERANCE = 0.025;  // a flat colour beyond the extreme, on its line
 const float RIDGE_NOISE_MARGIN = 1.5;
 const float EXPLAIN_TOLERANCE = 0.02;
 const float ON_LINE_TOLERANCE = 0.15;
@@ -219,7 +220,7 @@ Extension extend_extreme(vec4 far, vec4 near, ivec2 q, vec4 filtered_far, ivec2 
         vec4 offset = vec4(palette[i], 1.0) - near;
         float along = dot(offset, direction);
         float off_line = dot(offset, offset) - along * along;
-        if (along > t_far * (1.0 + RIDGE_MARGIN) && off_line < LINE_TOLERANCE * LINE_TOLERANCE)
+        if (along > t_far * (1.0 + RIDGE_MARGIN) && off_line < INK_LINE_TOLERANCE * INK_LINE_TOLERANCE)
             nearest = min(nearest, along / len);
     }
     if (nearest < 1e5) reach = min(nearest, reach);
