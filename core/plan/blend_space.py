@@ -122,9 +122,8 @@ def choose_blend_space(original_rgba, linear_input=False, lossless=True, drawn=N
         ``drawn(rows, cols)`` returns bool ``(K,)``: whether each pixel of O lies in a drawn
         region (text and graphics over a photo). Called for the confident edge pixels only
         where the whole window keeps linear light and `lossless`; those in drawn regions then
-        decide alone
-        when they are at least :data:`~aarecovery.plan.mixed_content.MIXED_DRAWN_SHARE` of
-        the window's.
+        decide alone when they are at least
+        :data:`~aarecovery.plan.mixed_content.MIXED_DRAWN_SHARE` of the window's.
 
     Returns
     -------
