@@ -86,6 +86,47 @@ def test_safe_plan_calibrates_a_palette_quantiser_of_a_photo():
     assert analysis.decision == Decision.COLOUR_MAP_CALIBRATED, analysis.reason
 
 
+def _quantised_poster():
+    from aarecovery.lab import realtools
+    suite = dataclasses.replace(realtools.REAL_FULL, families=("poster",), filters=("pil-quantize",),
+                                spaces={"poster": ("linear",)})
+    (case,) = realtools.build_cases(suite, "tune", jpeg=False)
+    return case
+
+
+def test_text_over_a_quantised_photo_gets_full_strength():
+    """The tuning half's poster in linear light under Pillow's quantize: the calibration
+    chooses 0.5 for the photo, and the text and graphics over it, read as hard-edged by the
+    local plan, get full strength. One strength for the whole image left 0.43 of their edge
+    error removed, the local plan 0.53; the photo regions keep theirs."""
+    from aarecovery.lab.metrics import edge_band, error_reduction
+    case = _quantised_poster()
+    band = edge_band(case.original, case.filtered, case.reference)
+    text, photo = band & case.regions["text/graphics"], band & case.regions["photo"]
+    with aarecovery.Engine("numpy") as engine:
+        engine.set_images(case.original, case.filtered)
+        plan = engine.plan()
+        assert plan.decision == Decision.COLOUR_MAP_CALIBRATED and plan.local is not None, plan.reason
+        assert plan.strength == 1 and 0 < plan.local.textured < 1, plan.reason
+        gains = []
+        for each in (plan, dataclasses.replace(plan, local=None, strength=plan.local.textured)):
+            engine.run(each)
+            recovered = engine.result()
+            gains.append([error_reduction(recovered, case.filtered, case.reference, region) for region in (text, photo)])
+    (text_local, photo_local), (text_one, photo_one) = gains
+    assert text_local > 0.5 and text_one < 0.45, gains
+    assert abs(photo_local - photo_one) < 0.01 and photo_local > 0.3, gains
+
+
+def test_a_quantised_photos_local_plan_agrees_on_gl(gl_path):
+    case = _quantised_poster()
+    numpy_result = aarecovery.recover(case.original, case.filtered, backend="numpy")
+    with aarecovery.Engine("gl", gl_path=gl_path) as engine:
+        gl_result = aarecovery.recover(case.original, case.filtered, engine=engine)
+        assert engine.last_plan.local is not None, engine.last_plan.reason
+    np.testing.assert_allclose(gl_result, numpy_result, atol=1e-5)
+
+
 def test_an_indexed_colour_drawing_is_repaired_as_a_point_wise_map(backend):
     """A map converted to indexed colour (Pillow's median cut to 6 colours, no dithering): no
     table of one key explains it, and its flat palette colours read as a smoothing filter
