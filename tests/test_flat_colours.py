@@ -256,16 +256,10 @@ def test_text_over_a_photo_under_an_unsharp_mask_gets_its_pure_colours(monkeypat
     text keeps 0.09 of its few flat pixels, all within the halos. Its text and graphics had
     0.16 of their edge error removed without pure colours, 0.48 with them; the photo regions
     keep theirs."""
-    from aarecovery.lab import realtools
-    from aarecovery.lab.metrics import edge_band, error_reduction
+    from aarecovery.lab.metrics import error_reduction
     from aarecovery.plan import analysis
-    from test_realtools import require_tool
-    require_tool(realtools.TOOL_FILTERS["im-unsharp"].tool)
-    suite = dataclasses.replace(realtools.REAL_FULL, families=("poster",), filters=("im-unsharp",),
-                                spaces={"poster": ("srgb",)})
-    (case,) = realtools.build_cases(suite, "tune", jpeg=False)
-    band = edge_band(case.original, case.filtered, case.reference)
-    text, photo = band & case.regions["text/graphics"], band & case.regions["photo"]
+    from test_realtools import real_case
+    case, text, photo = real_case("poster", "im-unsharp", "srgb")
 
     def repaired():
         recovered = aarecovery.recover(case.original, case.filtered, engine=engine)

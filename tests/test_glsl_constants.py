@@ -43,8 +43,6 @@ TWINS = {
     ("local_plan.glsl", "KEPT_CONTRAST_LOW"): local_plan.KEPT_CONTRAST_LOW,
     ("local_plan.glsl", "KEPT_CONTRAST_HIGH"): local_plan.KEPT_CONTRAST_HIGH,
     ("local_plan.glsl", "INK_TIE"): local_plan.INK_TIE,
-    ("local_plan.glsl", "INK_SHARE_LOW"): local_plan.INK_SHARE_LOW,
-    ("local_plan.glsl", "INK_SHARE_HIGH"): local_plan.INK_SHARE_HIGH,
     ("local_plan.glsl", "INK_GATE_SHARE_LOW"): local_plan.INK_GATE_SHARE_LOW,
     ("local_plan.glsl", "INK_GATE_SHARE_HIGH"): local_plan.INK_GATE_SHARE_HIGH,
     ("local_plan.glsl", "INK_GATE_REPEATS"): local_plan.INK_GATE_REPEATS,

@@ -5,6 +5,7 @@ OpenCV a pip package of the test extra; a missing one fails these tests in CI (C
 skips them loudly elsewhere.
 """
 
+import dataclasses
 import os
 import subprocess
 
@@ -30,6 +31,18 @@ def require_tool(name):
             pytest.fail(message)
         pytest.skip("REAL-TOOLS TEST NOT RUN: " + message)
     return tool
+
+
+def real_case(family, filter_name, space, half="tune"):
+    """The PNG case of the real-tools suite's `family` made in `space` under `filter_name`
+    (its tool required), and its edge band's text and graphics and photo regions."""
+    from aarecovery.lab.metrics import edge_band
+    require_tool(realtools.TOOL_FILTERS[filter_name].tool)
+    suite = dataclasses.replace(realtools.REAL_FULL, families=(family,), filters=(filter_name,),
+                                spaces={family: (space,)})
+    (case,) = realtools.build_cases(suite, half, jpeg=False)
+    band = edge_band(case.original, case.filtered, case.reference)
+    return case, band & case.regions["text/graphics"], band & case.regions["photo"]
 
 
 def _ramp(width=64):

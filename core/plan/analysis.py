@@ -80,7 +80,7 @@ from ..backends.base import Decision
 from ..colour import linear_to_srgb
 from ..contract import layout_of, to_rgba_float
 from ..params import ITERATIONS, SIGMA_D, SIGMA_E
-from ..spec.local_plan import FLAT_SPAN, LocalStrength
+from ..spec.local_plan import FLAT_SPAN, SHARPENED_INK_SHARE_HIGH, SHARPENED_INK_SHARE_LOW, LocalStrength
 from ..spec.sobel import gradient_magnitude
 from .ahead import InOrder, analyses_ahead
 from .blend_space import choose_blend_space, means_tell_srgb
@@ -591,15 +591,22 @@ def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterat
                     # 0.006 -> 0.009 (the poster's least -0.009 -> -0.016); held out, text 0.365 ->
                     # 0.371 but photo regions worse than F 3 -> 5 and the banner under
                     # ImageMagick's saturation boost (read as a smoothing filter) 0.16 dB below
-                    # F: the photo's own pixels beside a stroke read as part ink. Not taken.
+                    # F: the photo's own pixels beside a stroke read as part ink. Not taken
+                    # under a smoothing filter, whose photo keeps F; under a sharpening one,
+                    # whose photo takes a low strength, it is (below).
                     pure = f", pure colours of thin features there ({kept})" if prior is not None else ""
+                    # Under a sharpening filter the photo's side of a stroke's edge, which holds
+                    # little of the ink, gets the text's strength from a tenth of it
+                    # (spec.local_plan.SHARPENED_INK_SHARE_LOW has the measurements).
+                    local = (LocalStrength(photo_strength) if smoothing else
+                             LocalStrength(photo_strength, ink_shares=(SHARPENED_INK_SHARE_LOW, SHARPENED_INK_SHARE_HIGH)))
                     return PairAnalysis(space, strength,
                                         f"neighbourhood filter on a textured image ({texture}) with text or drawings "
                                         f"over it ({drawn:.2f} of the edges): strength {strength:g} there{pure}, "
                                         + (f"strength {photo_strength:g} in the rest" if photo_strength else "F kept in the rest")
                                         + (_UNTOUCHED if smoothing else "")
                                         + (_TOWARD if toward else ""),
-                                        Decision.NEIGHBOURHOOD_MIXED, prior, local=LocalStrength(photo_strength),
+                                        Decision.NEIGHBOURHOOD_MIXED, prior, local=local,
                                         untouched_span=UNTOUCHED_SPAN if smoothing else 0.0,
                                         toward_original=toward)
             strength = _textured_strength(grey, smoothing, compression.compressed)

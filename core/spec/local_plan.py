@@ -72,7 +72,7 @@ __all__ = ["LocalStrength", "encoded_colour", "strength_map", "neighbourhood_ext
            "ink_weight", "ink_weight_at", "REACH", "REGION_RADIUS", "TEXTURED_SHARE", "HARD_EDGED_SHARE", "INK_RADIUS",
            "INK_REPEATS",
            "INK_NEAR_SPAN", "INK_DARK", "INK_TIE", "INK_SHARE_LOW", "INK_SHARE_HIGH", "INK_GATE_SHARE_LOW",
-           "INK_GATE_SHARE_HIGH", "INK_GATE_REPEATS", "INK_LUMA_SATURATION", "INK_LUMA_DARK", "kept_contrast",
+           "INK_GATE_SHARE_HIGH", "INK_GATE_REPEATS", "SHARPENED_INK_SHARE_LOW", "SHARPENED_INK_SHARE_HIGH", "INK_LUMA_SATURATION", "INK_LUMA_DARK", "kept_contrast",
            "KEPT_CONTRAST_LOW", "KEPT_CONTRAST_HIGH"]
 
 #: A pixel is flat when its 3 x 3 neighbourhood spans at most this in every channel: equal
@@ -109,6 +109,17 @@ INK_TIE = 0.25 / 255
 #: which the weight rises, and at which it is full: a smoothstep between.
 INK_SHARE_LOW = 0.3
 INK_SHARE_HIGH = 0.7
+#: The strength's shares under a sharpening filter over a photo (``neighbourhood-mixed``,
+#: whose photo keeps the low strength of a sharpened photo): the photo's side of a stroke's
+#: edge holds little of the ink, and from 0.3 it kept that strength, half of each of the
+#: poster's text edges. Tuning half, the poster and screenshot under the two unsharp masks
+#: (8 PNG cases), text and graphics by lows and highs 0.3 / 0.7 (the strength's), 0.2 / 0.6,
+#: 0.1 / 0.7, 0.1 / 0.5, 0.0 / 0.4: 0.505, 0.522, 0.528, 0.543, 0.562; photo regions 0.206,
+#: 0.209, 0.211, 0.209, 0.205 (a poster's photo region at most 0.001, 0.001, 0.005, 0.012
+#: below the strength's). A smoothing filter's photo keeps F: there a low of 0.1 put
+#: held-out photo regions below F (``plan.analysis``).
+SHARPENED_INK_SHARE_LOW = 0.1
+SHARPENED_INK_SHARE_HIGH = 0.5
 #: The same for the gate of pure colours on drawn content (``LocalStrength.gate``): it opens
 #: at any share of the ink, full from a third. The strength keeps the photo pixel beside a
 #: stroke at the calibrated factor; the gate lets that pixel's ink extreme, the stroke's
@@ -247,7 +258,7 @@ def ink_weight(encoded, shares=(INK_SHARE_LOW, INK_SHARE_HIGH), repeats=INK_REPE
 _GATHERED_SHARE = 0.3
 
 
-def ink_weight_at(encoded, rows, cols, span=FLAT_SPAN):
+def ink_weight_at(encoded, rows, cols, span=FLAT_SPAN, shares=(INK_SHARE_LOW, INK_SHARE_HIGH)):
     """float32 ``(K,)``: :func:`ink_weight` at the pixels ``(rows[k], cols[k])`` only, the
     same values, reading only their neighbourhoods (the summary line reads it at a
     window's edge pixels: 4% of the window on a photo, 5 ms against 90 ms).
@@ -258,13 +269,13 @@ def ink_weight_at(encoded, rows, cols, span=FLAT_SPAN):
         O's sRGB-encoded colour (borders replicated).
     rows, cols : ndarray of int, shape (K,)
         The pixels.
-    span : float, optional
+    span, shares : optional
         As for :func:`ink_weight`.
     """
     encoded = np.asarray(encoded, np.float32)
     rows, cols = np.asarray(rows, np.intp), np.asarray(cols, np.intp)
     if rows.size > _GATHERED_SHARE * encoded.shape[0] * encoded.shape[1]:
-        return ink_weight(encoded, span=span)[rows, cols]
+        return ink_weight(encoded, shares, span=span)[rows, cols]
     replicated = np.pad(encoded, ((1, 1), (1, 1), (0, 0)), mode="edge")
     # Row by row, as _extremes visits them.
     extremes = _pick_extremes(np.ascontiguousarray(replicated[rows + dy, cols + dx].T)
@@ -274,8 +285,7 @@ def ink_weight_at(encoded, rows, cols, span=FLAT_SPAN):
     counts = [(np.zeros(rows.size, np.int32), np.zeros(rows.size, np.int32)) for _ in extremes]
     _count_recurrences((outside[rows + dy, cols + dx].T for dy in range(2 * radius + 1) for dx in range(2 * radius + 1)),
                        extremes, span, counts)
-    return _ink_weight(np.ascontiguousarray(encoded[rows, cols].T), extremes, counts, (INK_SHARE_LOW, INK_SHARE_HIGH),
-                       INK_REPEATS)
+    return _ink_weight(np.ascontiguousarray(encoded[rows, cols].T), extremes, counts, shares, INK_REPEATS)
 
 
 def _ink_weight(planes, extremes, recurrences, shares, repeats):
@@ -437,11 +447,17 @@ class LocalStrength:
         where captions and lines drawn on it repeat their colour exactly; no on hatching and
         screentone, whose strokes repeat theirs too but lose at full strength under a
         smoothing filter (``aarecovery.plan.hatching``).
+    ink_shares : (float, float)
+        The pixel's share of the drawn ink at which its weight starts to rise and is full
+        (:func:`ink_weight`'s `shares`): :data:`INK_SHARE_LOW`, :data:`INK_SHARE_HIGH`, or
+        under a sharpening filter over a photo :data:`SHARPENED_INK_SHARE_LOW`,
+        :data:`SHARPENED_INK_SHARE_HIGH`.
     """
 
     textured: float
     textured_regions: str = "photo"
     drawn_ink: bool = True
+    ink_shares: tuple = (INK_SHARE_LOW, INK_SHARE_HIGH)
 
     #: How far the factor at a pixel reads O (a tile's extra halo).
     reach = REACH
@@ -456,7 +472,7 @@ class LocalStrength:
         """
         weight = self.region_weight(encoded)
         if self.drawn_ink:
-            weight = np.maximum(weight, ink_weight(encoded))
+            weight = np.maximum(weight, ink_weight(encoded, self.ink_shares))
         return self._from_weight(weight)
 
     @staticmethod
@@ -518,7 +534,7 @@ class LocalStrength:
         """
         weight = hard_edged_weight(flat_share(encoded)[rows, cols])
         if self.drawn_ink:
-            weight = np.maximum(weight, ink_weight_at(encoded, rows, cols))
+            weight = np.maximum(weight, ink_weight_at(encoded, rows, cols, shares=self.ink_shares))
         return self._from_weight(weight)
 
     def hard_edged_share(self, encoded, edges):

@@ -603,7 +603,8 @@ class GLBackend:
                  (last_inputs, _factor_texture(kept_ink), "active"))
         for number, (inputs, output, list_name) in enumerate(steps, 1):
             where = {} if blocks is None else {"blocks": blocks[0], "list_name": list_name}
-            uniforms = {"textured": local.textured, "ink_gate_span": float(ink_span)}
+            uniforms = {"textured": local.textured, "ink_shares": tuple(map(float, local.ink_shares)),
+                        "ink_gate_span": float(ink_span)}
             beta_only = ({"FACTOR_FOR_BETA": int(for_beta), "DRAWN_INK": int(local.drawn_ink), "INK_GATE": int(ink_gate),
                           "KEPT_INK": int(kept_ink)} if number == 3 else {})
             self._run_pass("local_plan", inputs, [self._work(output)], uniforms=uniforms,

@@ -40,8 +40,6 @@ const int INK_REPEATS = 3;
 const float INK_NEAR_SPAN = 3.5 / 255.0;
 const float INK_DARK = 5.5 / 255.0;
 const float INK_TIE = 0.25 / 255.0;
-const float INK_SHARE_LOW = 0.3;
-const float INK_SHARE_HIGH = 0.7;
 const float INK_GATE_SHARE_LOW = 0.0;
 const float INK_GATE_SHARE_HIGH = 0.3;
 const int INK_GATE_REPEATS = 2;
@@ -54,6 +52,7 @@ const float KEPT_CONTRAST_HIGH = 1.05;
 uniform sampler2D original_image;  // O as uploaded (passes 1 and 3)
 uniform sampler2D local_input;     // the previous pass's output (passes 2 and 3)
 uniform float textured;            // the factor in textured regions (pass 3)
+uniform vec2 ink_shares;           // the strength's ink shares, low and high: LocalStrength.ink_shares (pass 3)
 uniform float ink_gate_span;       // within what the gate's ink recurs: FLAT_SPAN, wider on a JPEG (pass 3)
 #if FACTOR_FOR_BETA || KEPT_INK
 uniform sampler2D filtered_image;  // F as uploaded (pass 3)
@@ -149,8 +148,8 @@ vec2 ink_weight(ivec2 p, ivec2 size, bool needed) {
         float span = sqrt(across.r * across.r + across.g * across.g + across.b * across.b);
         float share = span > 0.0 ? 1.0 - sqrt(from_ink.r * from_ink.r + from_ink.g * from_ink.g
                                               + from_ink.b * from_ink.b) / span : 0.0;
-        vec2 t = clamp((vec2(share) - vec2(INK_SHARE_LOW, INK_GATE_SHARE_LOW))
-                       / vec2(INK_SHARE_HIGH - INK_SHARE_LOW, INK_GATE_SHARE_HIGH - INK_GATE_SHARE_LOW), 0.0, 1.0);
+        vec2 t = clamp((vec2(share) - vec2(ink_shares.x, INK_GATE_SHARE_LOW))
+                       / vec2(ink_shares.y - ink_shares.x, INK_GATE_SHARE_HIGH - INK_GATE_SHARE_LOW), 0.0, 1.0);
         weight = max(weight, mix(vec2(0.0), t * t * (3.0 - 2.0 * t), drawn));
     }
     return weight;
