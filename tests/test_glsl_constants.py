@@ -41,6 +41,7 @@ TWINS = {
     ("local_plan.glsl", "INK_NEAR_SPAN"): local_plan.INK_NEAR_SPAN,
     ("local_plan.glsl", "INK_DARK"): local_plan.INK_DARK,
     ("local_plan.glsl", "KEPT_CONTRAST_LOW"): local_plan.KEPT_CONTRAST_LOW,
+    ("local_plan.glsl", "STEEPENED_CONTRAST_HIGH"): local_plan.STEEPENED_CONTRAST_HIGH,
     ("local_plan.glsl", "KEPT_CONTRAST_HIGH"): local_plan.KEPT_CONTRAST_HIGH,
     ("local_plan.glsl", "INK_TIE"): local_plan.INK_TIE,
     ("local_plan.glsl", "INK_GATE_SHARE_LOW"): local_plan.INK_GATE_SHARE_LOW,

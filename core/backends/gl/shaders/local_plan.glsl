@@ -48,6 +48,7 @@ const float INK_LUMA_DARK = 31.5 / 255.0;
 const float LUMA_TIE = 0.00005 / 255.0;
 const float KEPT_CONTRAST_LOW = 0.9;
 const float KEPT_CONTRAST_HIGH = 1.05;
+const float STEEPENED_CONTRAST_HIGH = 1.2;
 
 uniform sampler2D original_image;  // O as uploaded (passes 1 and 3)
 uniform sampler2D local_input;     // the previous pass's output (passes 2 and 3)
@@ -207,11 +208,13 @@ float encoded_span(sampler2D image, ivec2 p, ivec2 size) {
     return max(span.r, max(span.g, span.b));
 }
 
-// How fully F kept O's contrast around p, 0 to 1 (twin: kept_contrast).
-float kept_contrast(ivec2 p, ivec2 size) {
+// How fully F kept O's contrast around p, 0 to 1, full at KEPT_CONTRAST_HIGH (.x) and at
+// STEEPENED_CONTRAST_HIGH (.y) (twin: kept_contrast).
+vec2 kept_contrast(ivec2 p, ivec2 size) {
     float original_span = encoded_span(original_image, p, size);
     float ratio = original_span > 0.0 ? encoded_span(filtered_image, p, size) / original_span : 0.0;
-    float t = clamp((ratio - KEPT_CONTRAST_LOW) / (KEPT_CONTRAST_HIGH - KEPT_CONTRAST_LOW), 0.0, 1.0);
+    vec2 t = clamp((vec2(ratio) - KEPT_CONTRAST_LOW)
+                   / (vec2(KEPT_CONTRAST_HIGH, STEEPENED_CONTRAST_HIGH) - KEPT_CONTRAST_LOW), 0.0, 1.0);
     return t * t * (3.0 - 2.0 * t);
 }
 #endif
@@ -266,7 +269,8 @@ vec3 local_plan(ivec2 p, ivec2 size) {
     float weight = DRAWN_INK != 0 ? max(region, ink.x) : region;
     float gate = INK_GATE != 0 ? max(region, ink.y) : region;
 #if KEPT_INK
-    float kept_ink = max(region, ink.y) * kept_contrast(p, size);
+    vec2 kept = kept_contrast(p, size);
+    float kept_ink = max(max(region, ink.y) * kept.x, kept.y);
 #else
     float kept_ink = 0.0;
 #endif
