@@ -112,7 +112,8 @@ def test_text_over_a_quantised_photo_gets_full_strength():
         for each in (plan, dataclasses.replace(plan, local=None, strength=plan.local.textured)):
             engine.run(each)
             recovered = engine.result()
-            gains.append([error_reduction(recovered, case.filtered, case.reference, region) for region in (text, photo)])
+            gains.append([error_reduction(recovered, case.filtered, case.reference, region)
+                          for region in (text, photo)])
     (text_local, photo_local), (text_one, photo_one) = gains
     assert text_local > 0.5 and text_one < 0.45, gains
     assert abs(photo_local - photo_one) < 0.01 and photo_local > 0.3, gains

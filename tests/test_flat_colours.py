@@ -270,7 +270,8 @@ def test_text_over_a_photo_under_an_unsharp_mask_gets_its_pure_colours(monkeypat
     plan, text_gain, photo_gain = repaired()
     assert plan.decision == aarecovery.Decision.NEIGHBOURHOOD_MIXED and plan.pure_colours is not None, plan.reason
     asked = analysis.flat_colour_prior
-    monkeypatch.setattr(analysis, "flat_colour_prior", lambda *args, **kwargs: asked(*args, **{**kwargs, "sharpened": False}))
+    monkeypatch.setattr(analysis, "flat_colour_prior",
+                        lambda *args, **kwargs: asked(*args, **{**kwargs, "sharpened": False}))
     plan_before, text_before, photo_before = repaired()
     assert plan_before.pure_colours is None, plan_before.reason
     assert text_gain > 0.4 and text_before < 0.25, (text_gain, text_before)

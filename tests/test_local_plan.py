@@ -362,7 +362,8 @@ def test_gl_computes_the_sharpened_shares_strength_map_as_numpy(banner_over_phot
         with aarecovery.Engine(backend, gl_path=gl_path if backend == "gl" else "auto") as engine:
             engine.set_images(case.original, case.filtered)
             plan = engine.plan()
-            for name, local in (("plain", plan.local), ("sharpened", dataclasses.replace(plan.local, ink_shares=shares))):
+            sharpened = dataclasses.replace(plan.local, ink_shares=shares)
+            for name, local in (("plain", plan.local), ("sharpened", sharpened)):
                 engine.run(dataclasses.replace(plan, local=local), maps=True)
                 maps[backend, name] = engine.maps().strength
     np.testing.assert_allclose(maps["gl", "sharpened"], maps["numpy", "sharpened"], atol=_FACTOR_TOLERANCE)

@@ -598,8 +598,8 @@ def _decide(original_rgba, filtered_rgba, linear_input, sigma_d, sigma_e, iterat
                     # Under a sharpening filter the photo's side of a stroke's edge, which holds
                     # little of the ink, gets the text's strength from a tenth of it
                     # (spec.local_plan.SHARPENED_INK_SHARE_LOW has the measurements).
-                    local = (LocalStrength(photo_strength) if smoothing else
-                             LocalStrength(photo_strength, ink_shares=(SHARPENED_INK_SHARE_LOW, SHARPENED_INK_SHARE_HIGH)))
+                    shares = {} if smoothing else {"ink_shares": (SHARPENED_INK_SHARE_LOW, SHARPENED_INK_SHARE_HIGH)}
+                    local = LocalStrength(photo_strength, **shares)
                     return PairAnalysis(space, strength,
                                         f"neighbourhood filter on a textured image ({texture}) with text or drawings "
                                         f"over it ({drawn:.2f} of the edges): strength {strength:g} there{pure}, "

@@ -31,8 +31,9 @@ runs the same passes on each tile: 1, 2 and the sums of 3 along rows, then along
 5. :meth:`LocalStrength.factor`: the factor of the confidence ``beta``, from the textured
    strength (photo regions) to 1 (hard-edged regions or drawn ink), by the larger weight.
 6. Under a smoothing filter over a photo, :meth:`LocalStrength.kept_ink`: the drawn ink's
-   weight towards O, by how fully F kept O's contrast there (:func:`kept_contrast`; the GL
-   twin's pass 3 reads F too and writes it in a third channel).
+   weight towards O, by how fully F kept O's contrast there, and every pixel's by how far F
+   steepened it (:func:`kept_contrast`; the GL twin's pass 3 reads F too and writes it in a
+   third channel).
 
 Thresholds chosen on the tuning half of the mixed scenes (shares 0.05-0.25, 0.1-0.3 and
 0.15-0.35, radii 6, 8 and 16: graphics 0.596-0.609, photo 0.360-0.367 of the edge error
@@ -72,8 +73,9 @@ __all__ = ["LocalStrength", "encoded_colour", "strength_map", "neighbourhood_ext
            "ink_weight", "ink_weight_at", "REACH", "REGION_RADIUS", "TEXTURED_SHARE", "HARD_EDGED_SHARE", "INK_RADIUS",
            "INK_REPEATS",
            "INK_NEAR_SPAN", "INK_DARK", "INK_TIE", "INK_SHARE_LOW", "INK_SHARE_HIGH", "INK_GATE_SHARE_LOW",
-           "INK_GATE_SHARE_HIGH", "INK_GATE_REPEATS", "SHARPENED_INK_SHARE_LOW", "SHARPENED_INK_SHARE_HIGH", "INK_LUMA_SATURATION", "INK_LUMA_DARK", "kept_contrast",
-           "KEPT_CONTRAST_LOW", "KEPT_CONTRAST_HIGH", "STEEPENED_CONTRAST_HIGH"]
+           "INK_GATE_SHARE_HIGH", "INK_GATE_REPEATS", "SHARPENED_INK_SHARE_LOW", "SHARPENED_INK_SHARE_HIGH",
+           "INK_LUMA_SATURATION", "INK_LUMA_DARK", "kept_contrast", "KEPT_CONTRAST_LOW", "KEPT_CONTRAST_HIGH",
+           "STEEPENED_CONTRAST_HIGH"]
 
 #: A pixel is flat when its 3 x 3 neighbourhood spans at most this in every channel: equal
 #: 8-bit values (the 8-bit grid is 1/255 apart).
