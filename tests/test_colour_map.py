@@ -87,11 +87,10 @@ def test_safe_plan_calibrates_a_palette_quantiser_of_a_photo():
 
 
 def _quantised_poster():
-    from aarecovery.lab import realtools
-    suite = dataclasses.replace(realtools.REAL_FULL, families=("poster",), filters=("pil-quantize",),
-                                spaces={"poster": ("linear",)})
-    (case,) = realtools.build_cases(suite, "tune", jpeg=False)
-    return case
+    """The tuning half's poster in linear light under Pillow's quantize, and its edge band's
+    text and graphics and photo regions."""
+    from test_realtools import real_case
+    return real_case("poster", "pil-quantize", "linear")
 
 
 def test_text_over_a_quantised_photo_gets_full_strength():
@@ -99,10 +98,8 @@ def test_text_over_a_quantised_photo_gets_full_strength():
     chooses 0.5 for the photo, and the text and graphics over it, read as hard-edged by the
     local plan, get full strength. One strength for the whole image left 0.43 of their edge
     error removed, the local plan 0.53; the photo regions keep theirs."""
-    from aarecovery.lab.metrics import edge_band, error_reduction
-    case = _quantised_poster()
-    band = edge_band(case.original, case.filtered, case.reference)
-    text, photo = band & case.regions["text/graphics"], band & case.regions["photo"]
+    from aarecovery.lab.metrics import error_reduction
+    case, text, photo = _quantised_poster()
     with aarecovery.Engine("numpy") as engine:
         engine.set_images(case.original, case.filtered)
         plan = engine.plan()
@@ -120,7 +117,7 @@ def test_text_over_a_quantised_photo_gets_full_strength():
 
 
 def test_a_quantised_photos_local_plan_agrees_on_gl(gl_path):
-    case = _quantised_poster()
+    case, _, _ = _quantised_poster()
     numpy_result = aarecovery.recover(case.original, case.filtered, backend="numpy")
     with aarecovery.Engine("gl", gl_path=gl_path) as engine:
         gl_result = aarecovery.recover(case.original, case.filtered, engine=engine)

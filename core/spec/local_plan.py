@@ -410,12 +410,21 @@ def kept_contrast(encoded_original, encoded_filtered, high=KEPT_CONTRAST_HIGH):
         The ratio at which it is full: :data:`KEPT_CONTRAST_HIGH`, or
         :data:`STEEPENED_CONTRAST_HIGH` for every pixel's move towards O.
     """
+    return _kept_from(_span_ratio(encoded_original, encoded_filtered), high)
+
+
+def _span_ratio(encoded_original, encoded_filtered):
+    """F's 3 x 3 span over O's (largest channel), 0 where O is flat (:func:`kept_contrast`)."""
     def span(encoded):
         highest, lowest = neighbourhood_extremes(encoded)
         return (highest - lowest).max(axis=-1)
 
     original_span = span(encoded_original)
-    ratio = np.where(original_span > 0, span(encoded_filtered) / np.where(original_span > 0, original_span, 1), 0)
+    return np.where(original_span > 0, span(encoded_filtered) / np.where(original_span > 0, original_span, 1), 0)
+
+
+def _kept_from(ratio, high):
+    """:func:`kept_contrast` of a span ratio: the smoothstep from KEPT_CONTRAST_LOW to `high`."""
     t = np.clip((ratio - np.float32(KEPT_CONTRAST_LOW)) / np.float32(high - KEPT_CONTRAST_LOW), 0, 1)
     return (t * t * (3 - 2 * t)).astype(np.float32)
 
@@ -537,8 +546,10 @@ class LocalStrength:
         encoded, encoded_filtered : ndarray of float32, shape (H, W, 3)
             O's and F's sRGB-encoded colour.
         """
-        return np.maximum(LocalStrength.gate(encoded, True) * kept_contrast(encoded, encoded_filtered),
-                          kept_contrast(encoded, encoded_filtered, STEEPENED_CONTRAST_HIGH)).astype(np.float32)
+        # One span ratio for both smoothsteps, as the GL twin reads it once.
+        ratio = _span_ratio(encoded, encoded_filtered)
+        return np.maximum(LocalStrength.gate(encoded, True) * _kept_from(ratio, KEPT_CONTRAST_HIGH),
+                          _kept_from(ratio, STEEPENED_CONTRAST_HIGH)).astype(np.float32)
 
     def factor_at(self, encoded, rows, cols):
         """float32 ``(K,)``: :meth:`factor` at the pixels ``(rows[k], cols[k])`` of O only,
